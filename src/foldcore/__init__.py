@@ -1,0 +1,44 @@
+"""foldcore: geometry-based simulation of thick origami.
+
+Data flow: pattern → thick mesh → system → simulation → result → outputs::
+
+    import foldcore
+    pattern = foldcore.patterns.single_hinge(panel_length=5, angle=90)
+    mesh = foldcore.thicken(pattern, thickness=1.0, hinge_width=2.0, subdivisions=4)
+    sim = foldcore.Simulation(mesh, pattern)
+    result = sim.run(tolerance=1e-9)
+    result.fold_angles_deg[0]          # ≈ 90 (degrees, valley > 0)
+
+Units: mm and degrees at every public API. Submodules are imported lazily so
+that ``import foldcore`` is fast and never imports numba kernels or pyvista.
+"""
+from importlib import import_module
+
+from .errors import FoldcoreError, MeshError, PatternError, PatternWarning, SimulationError
+
+__version__ = "0.1.0"
+
+_LAZY = {
+    "CreasePattern": ("foldcore.pattern", "CreasePattern"),
+    "thicken": ("foldcore.thicken", "thicken"),
+    "ThickMesh": ("foldcore.mesh", "ThickMesh"),
+    "Simulation": ("foldcore.simulation", "Simulation"),
+    "Result": ("foldcore.simulation", "Result"),
+    "read": ("foldcore.io", "read"),
+    "write_fold": ("foldcore.io", "write_fold"),
+    "patterns": ("foldcore.patterns", None),
+    "kinematics": ("foldcore.kinematics", None),
+}
+
+__all__ = ["FoldcoreError", "MeshError", "PatternError", "PatternWarning",
+           "SimulationError", *_LAZY]
+
+
+def __getattr__(name):
+    if name not in _LAZY:
+        raise AttributeError(f"module 'foldcore' has no attribute {name!r}")
+    module, attr = _LAZY[name]
+    value = import_module(module)
+    value = value if attr is None else getattr(value, attr)
+    globals()[name] = value
+    return value

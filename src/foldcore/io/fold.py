@@ -1,0 +1,427 @@
+"""Read and write FOLD files (JSON, FOLD spec 1.2) as :class:`CreasePattern`.
+
+Reading: frame 0 (the key frame) is the crease pattern; ``file_frames`` and
+unknown keys are ignored.
+
+* ``vertices_coords`` — 2D, or 3D with z = 0 (required).
+* ``edges_vertices`` — vertex ids per edge (required).
+* ``edges_assignment`` — ``M V B F U`` (lower case accepted). When absent,
+  edges with a face on both sides become ``U`` and the others ``B``.
+* ``faces_vertices`` — optional; derived from the planar graph when absent,
+  ``null`` or empty.
+* ``edges_foldAngle`` — degrees, valley positive: a number is an actuated
+  target, ``null`` (or no key) a passive crease.
+* ``frame_unit`` — every length (coordinates, widths, thickness) is converted
+  to mm: ``unit`` (or absent) and ``mm`` ×1, ``cm`` ×10, ``m`` ×1000,
+  ``in`` ×25.4, ``pt`` ×25.4/72, ``um`` ×1e-3, ``nm`` ×1e-6.
+
+foldcore's own keys (lengths in the file's ``frame_unit``; foldcore writes mm):
+
+* ``foldcore:edges_width`` — hinge width per edge, ``null`` = automatic (Eq. 7).
+* ``foldcore:edges_maxAngle`` — largest fold magnitude per edge, degrees,
+  ``null`` = 180.
+* ``foldcore:thickness`` — sheet thickness (file level).
+* ``foldcore:edges_targetAngle`` — written next to *achieved* angles in
+  ``edges_foldAngle`` (a simulation result); the target angles, degrees,
+  valley positive, ``null`` = passive. When present it is read instead of
+  ``edges_foldAngle``, so a result file reads back as the pattern simulated.
+
+Every malformed input raises :class:`PatternError` naming the file and the
+offending item; files above :data:`MAX_FILE_BYTES` are refused unread.
+"""
+from __future__ import annotations
+
+import json
+import os
+import secrets
+from collections import Counter
+from contextlib import contextmanager, suppress
+from dataclasses import dataclass
+from functools import partial
+
+import numpy as np
+
+from ..errors import PatternError
+from ..pattern import DEFAULT_MAX_ANGLE_DEG, CreasePattern
+from ..planar import derive_faces
+
+#: Largest input file read, bytes (256 MiB).
+MAX_FILE_BYTES = 256 * 1024 * 1024
+
+#: Millimetres per ``frame_unit``.
+UNIT_MM = {"unit": 1.0, "mm": 1.0, "cm": 10.0, "m": 1000.0, "in": 25.4,
+           "pt": 25.4 / 72.0, "um": 1e-3, "nm": 1e-6}
+
+WIDTH_KEY = "foldcore:edges_width"
+MAX_ANGLE_KEY = "foldcore:edges_maxAngle"
+THICKNESS_KEY = "foldcore:thickness"
+TARGET_KEY = "foldcore:edges_targetAngle"
+
+
+@dataclass(frozen=True)
+class FoldFile:
+    """A FOLD file's crease pattern plus the file-level values foldcore uses.
+
+    Attributes
+    ----------
+    pattern : CreasePattern
+        The key frame, lengths in mm.
+    thickness : float or None
+        Sheet thickness in mm (``foldcore:thickness``); None when absent.
+    frame_unit : str
+        The unit the file declared (``"unit"`` when absent); already applied.
+    """
+
+    pattern: CreasePattern
+    thickness: float | None
+    frame_unit: str
+
+
+# ------------------------------------------------------------------- reading
+def read_fold(path) -> CreasePattern:
+    """Read the crease pattern of a FOLD file (lengths in mm, angles in degrees).
+
+    Raises
+    ------
+    PatternError
+        Unreadable, too large, not JSON, or not a valid crease pattern.
+    """
+    return read_fold_file(path).pattern
+
+
+def read_fold_file(path) -> FoldFile:
+    """Read a FOLD file: its crease pattern and ``foldcore:thickness`` (mm)."""
+    source = os.fspath(path)
+    return fold_file_from_dict(_parse_json(read_bytes(source), source), source)
+
+
+def pattern_from_fold_dict(d, source: str = "<fold>") -> CreasePattern:
+    """Build a :class:`CreasePattern` from a parsed FOLD object (a dict).
+
+    Parameters
+    ----------
+    d : dict
+        The top-level JSON object of a FOLD file.
+    source : str
+        Name used in error messages (the file name).
+    """
+    return fold_file_from_dict(d, source).pattern
+
+
+def fold_file_from_dict(d, source: str = "<fold>") -> FoldFile:
+    """Like :func:`pattern_from_fold_dict`, also returning thickness and unit."""
+    if not isinstance(d, dict):
+        _fail(source, f"the top level must be a JSON object, got {type(d).__name__}")
+    unit, scale = _unit_scale(d, source)
+    vertices = _coords(d, scale, source)
+    edges = _edges(d, len(vertices), source)
+    n = len(edges)
+    key = TARGET_KEY if d.get(TARGET_KEY) is not None else "edges_foldAngle"
+    widths = _per_edge(d, WIDTH_KEY, n, source)
+    max_angles = _per_edge(d, MAX_ANGLE_KEY, n, source)
+    args = dict(
+        vertices=vertices, edges=edges,
+        assignments=_assignments(d, vertices, edges, source),
+        fold_angles=_per_edge(d, key, n, source),
+        widths=None if widths is None else [None if w is None else w * scale for w in widths],
+        max_angles=None if max_angles is None else
+        [DEFAULT_MAX_ANGLE_DEG if m is None else m for m in max_angles],
+        faces=_faces(d, len(vertices), source), source=source)
+    return FoldFile(_build(args), _thickness(d, scale, source), unit)
+
+
+def read_bytes(path, limit: int | None = None) -> bytes:
+    """The bytes of a file, refusing files larger than ``limit`` before reading.
+
+    ``limit`` defaults to :data:`MAX_FILE_BYTES` (read at call time).
+    """
+    source = os.fspath(path)
+    limit = MAX_FILE_BYTES if limit is None else limit
+    try:
+        size = os.stat(source).st_size
+        if size > limit:
+            _fail(source, f"file is {size} bytes, larger than the {limit}-byte limit")
+        with open(source, "rb") as fh:
+            data = fh.read(limit + 1)
+    except OSError as exc:
+        raise PatternError(f"{source}: cannot read the file ({exc.strerror or exc})") from None
+    if len(data) > limit:
+        _fail(source, f"file is larger than the {limit}-byte limit")
+    return data
+
+
+def _parse_json(data: bytes, source: str):
+    try:
+        text = data.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        _fail(source, f"not UTF-8 text (bad byte at offset {exc.start})")
+    try:
+        return json.loads(text, parse_constant=partial(_bad_constant, source),
+                          parse_float=partial(_finite_float, source))
+    except PatternError:
+        raise
+    except json.JSONDecodeError as exc:
+        _fail(source, f"not valid JSON: {exc.msg} at line {exc.lineno}, column {exc.colno}")
+    except (ValueError, RecursionError) as exc:
+        _fail(source, f"not valid JSON ({type(exc).__name__}: {exc})")
+
+
+def _bad_constant(source: str, name: str):
+    _fail(source, f"not valid JSON: literal {name} (NaN/Infinity are not JSON; use null)")
+
+
+def _finite_float(source: str, text: str) -> float:
+    value = float(text)
+    if not np.isfinite(value):
+        _fail(source, f"number {text} is out of range of a 64-bit float")
+    return value
+
+
+def _unit_scale(d: dict, source: str) -> tuple[str, float]:
+    unit = d.get("frame_unit")
+    unit = "unit" if unit is None else unit
+    if not isinstance(unit, str) or unit not in UNIT_MM:
+        _fail(source, f"unknown frame_unit {_short(unit)} "
+                      f"(expected one of {', '.join(UNIT_MM)})")
+    return unit, UNIT_MM[unit]
+
+
+def _coords(d: dict, scale: float, source: str) -> list[list[float]]:
+    out = []
+    for i, row in enumerate(_required_list(d, "vertices_coords", source)):
+        xyz = [_number(x) for x in row] if isinstance(row, list) else []
+        if len(xyz) < 2 or None in xyz:
+            _fail(source, f"vertices_coords[{i}] (vertex {i}) must be 2 or 3 finite "
+                          f"numbers, got {_short(row)}")
+        if any(z != 0 for z in xyz[2:]):
+            _fail(source, f"vertex {i} has z = {xyz[2]:g}; the crease pattern "
+                          "(frame 0) must be flat (z = 0)")
+        out.append([xyz[0] * scale, xyz[1] * scale])
+    return out
+
+
+def _edges(d: dict, n_vertices: int, source: str) -> list[list[int]]:
+    out = []
+    for i, row in enumerate(_required_list(d, "edges_vertices", source)):
+        if not isinstance(row, list) or len(row) != 2:
+            _fail(source, f"edges_vertices[{i}] (edge {i}) must be [u, v], got {_short(row)}")
+        ids = [_index(x, n_vertices) for x in row]
+        if None in ids:
+            _fail(source, f"edge {i} refers to vertices {_short(row)}, but there are "
+                          f"{n_vertices} vertices (ids 0..{n_vertices - 1})")
+        out.append(ids)
+    return out
+
+
+def _faces(d: dict, n_vertices: int, source: str) -> list[list[int]] | None:
+    raw = d.get("faces_vertices")
+    if raw is None or raw == []:
+        return None
+    if not isinstance(raw, list):
+        _fail(source, f"faces_vertices must be a list, got {type(raw).__name__}")
+    out = []
+    for i, row in enumerate(raw):
+        ids = [_index(x, n_vertices) for x in row] if isinstance(row, list) else [None]
+        if None in ids:
+            _fail(source, f"faces_vertices[{i}] (face {i}) must list vertex ids "
+                          f"(there are {n_vertices} vertices), got {_short(row)}")
+        out.append(ids)
+    return out
+
+
+def _assignments(d: dict, vertices, edges, source: str) -> list[str]:
+    raw = d.get("edges_assignment")
+    if raw is None:
+        return _default_assignments(vertices, edges, source)
+    _check_length(raw, "edges_assignment", len(edges), source)
+    for i, a in enumerate(raw):
+        if not isinstance(a, str):
+            _fail(source, f"edges_assignment[{i}] (edge {i}) must be a string, got {_short(a)}")
+    return [a.upper() if len(a) == 1 else a for a in raw]
+
+
+def _default_assignments(vertices, edges, source: str) -> list[str]:
+    """``U`` for edges with faces on both sides, ``B`` for the others."""
+    v = np.asarray(vertices, dtype=np.float64).reshape(-1, 2)
+    e = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
+    try:
+        faces = derive_faces(v, e, np.zeros(len(e), dtype=bool), source)
+    except PatternError:
+        raise
+    except Exception:  # malformed graph: let CreasePattern name the problem
+        return ["U"] * len(e)
+    sides = Counter(frozenset(side) for f in faces
+                    for side in zip(f.tolist(), np.roll(f, -1).tolist()))
+    return ["U" if sides[frozenset(pair)] >= 2 else "B" for pair in e.tolist()]
+
+
+def _per_edge(d: dict, key: str, n_edges: int, source: str) -> list | None:
+    raw = d.get(key)
+    if raw is None:
+        return None
+    _check_length(raw, key, n_edges, source)
+    out = [None if x is None else _number(x) for x in raw]
+    for i, (x, value) in enumerate(zip(raw, out)):
+        if x is not None and value is None:
+            _fail(source, f"{key}[{i}] (edge {i}) must be a finite number or null, "
+                          f"got {_short(x)}")
+    return out
+
+
+def _thickness(d: dict, scale: float, source: str) -> float | None:
+    raw = d.get(THICKNESS_KEY)
+    if raw is None:
+        return None
+    value = _number(raw)
+    if value is None or not value > 0:
+        _fail(source, f"{THICKNESS_KEY} must be a positive number, got {_short(raw)}")
+    return value * scale
+
+
+def _build(args: dict) -> CreasePattern:
+    try:
+        return CreasePattern(**args)
+    except PatternError:
+        raise
+    except Exception as exc:  # last resort: never a raw traceback for user input
+        raise PatternError(f"{args['source']}: unexpected malformed pattern "
+                           f"({type(exc).__name__}: {exc})") from exc
+
+
+# ------------------------------------------------------------ value checks
+def _fail(source: str, message: str):
+    raise PatternError(f"{source}: {message}")
+
+
+def _short(value, limit: int = 60) -> str:
+    text = json.dumps(value) if isinstance(value, (list, dict, str, type(None))) else repr(value)
+    return text if len(text) <= limit else text[:limit - 3] + "..."
+
+
+def _required_list(d: dict, key: str, source: str) -> list:
+    if key not in d:
+        _fail(source, f"missing required key {key!r}")
+    if not isinstance(d[key], list):
+        _fail(source, f"{key} must be a list, got {type(d[key]).__name__}")
+    return d[key]
+
+
+def _check_length(raw, key: str, n_edges: int, source: str):
+    if not isinstance(raw, list):
+        _fail(source, f"{key} must be a list, got {type(raw).__name__}")
+    if len(raw) != n_edges:
+        _fail(source, f"{key} has {len(raw)} entries for {n_edges} edges "
+                      f"(edges_vertices); entry {min(len(raw), n_edges)} is the first mismatch")
+
+
+def _number(x) -> float | None:
+    """``x`` as a finite float, or None if it is not a finite JSON number."""
+    if isinstance(x, bool) or not isinstance(x, (int, float)):
+        return None
+    try:
+        value = float(x)
+    except OverflowError:
+        return None
+    return value if np.isfinite(value) else None
+
+
+def _index(x, n: int) -> int | None:
+    """``x`` as a vertex id in 0..n-1, or None."""
+    value = _number(x)
+    if value is None or value != int(value) or not 0 <= value < n:
+        return None
+    return int(value)
+
+
+# ------------------------------------------------------------------- writing
+def fold_dict(pattern: CreasePattern, achieved_angles=None, frames=None,
+              thickness: float | None = None, extra: dict | None = None) -> dict:
+    """The FOLD object (a dict ready for JSON) of a crease pattern or result.
+
+    Parameters
+    ----------
+    pattern : CreasePattern
+    achieved_angles : (E,) array_like of float, optional
+        Fold angles reached, degrees, valley positive; NaN → null. When given
+        they fill ``edges_foldAngle`` and the targets go to
+        ``foldcore:edges_targetAngle``.
+    frames : sequence of dict, optional
+        Extra frames (e.g. the folded thick solid), written as ``file_frames``
+        unchanged (NumPy arrays are converted when written).
+    thickness : float, optional
+        Sheet thickness, mm (``foldcore:thickness``).
+    extra : dict, optional
+        More top-level keys (use a ``foldcore:`` prefix); they win on clashes.
+    """
+    d = {"file_spec": 1.2, "file_creator": "foldcore", "file_classes": ["singleModel"],
+         "frame_classes": ["creasePattern"], "frame_attributes": ["2D"], "frame_unit": "mm",
+         "vertices_coords": pattern.vertices.tolist(),
+         "edges_vertices": pattern.edges.tolist(),
+         "edges_assignment": pattern.assignments.tolist(),
+         "faces_vertices": [f.tolist() for f in pattern.faces],
+         "edges_foldAngle": _nullable(pattern.fold_angles),
+         WIDTH_KEY: _nullable(pattern.widths), MAX_ANGLE_KEY: pattern.max_angles.tolist()}
+    if achieved_angles is not None:
+        achieved = np.asarray(achieved_angles, dtype=np.float64)
+        if achieved.shape != (pattern.n_edges,):
+            raise ValueError(f"achieved_angles has shape {achieved.shape}, "
+                             f"expected ({pattern.n_edges},)")
+        d[TARGET_KEY], d["edges_foldAngle"] = d["edges_foldAngle"], _nullable(achieved)
+    if thickness is not None:
+        d[THICKNESS_KEY] = float(thickness)
+    if frames is not None:
+        d["file_frames"] = list(frames)
+    d.update(extra or {})
+    return d
+
+
+def write_fold(path, pattern: CreasePattern, achieved_angles=None, frames=None,
+               thickness: float | None = None, extra: dict | None = None) -> None:
+    """Write :func:`fold_dict` to ``path`` atomically (no partial file on error).
+
+    Floats keep full precision (shortest round-trip repr), so reading the file
+    back gives the same pattern bit for bit. One top-level key per line.
+    """
+    d = fold_dict(pattern, achieved_angles, frames, thickness, extra)
+    dumps = partial(json.dumps, allow_nan=False, default=_jsonable)
+    with atomic_write(path) as fh:
+        fh.write("{\n")
+        for i, (key, value) in enumerate(d.items()):
+            fh.write(f"  {json.dumps(key)}: {dumps(value)}{',' if i < len(d) - 1 else ''}\n")
+        fh.write("}\n")
+
+
+@contextmanager
+def atomic_write(path):
+    """Open a text file for writing that appears at ``path`` only when complete.
+
+    Writes a temporary file in the same directory, fsyncs it and renames it over
+    ``path`` (:func:`os.replace`); on any exception the temporary file is removed
+    and ``path`` is left as it was.
+    """
+    target = os.fspath(path)
+    folder, name = os.path.split(os.path.abspath(target))
+    tmp = os.path.join(folder, f".{name}.{os.getpid()}.{secrets.token_hex(4)}.tmp")
+    fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666)
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as fh:
+            yield fh
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.replace(tmp, target)
+    except BaseException:
+        with suppress(OSError):
+            os.unlink(tmp)
+        raise
+
+
+def _nullable(values: np.ndarray) -> list:
+    return [float(x) if np.isfinite(x) else None for x in values]
+
+
+def _jsonable(obj):
+    if isinstance(obj, np.ndarray):
+        return obj.tolist()
+    if isinstance(obj, np.generic):
+        return obj.item()
+    raise TypeError(f"{type(obj).__name__} is not JSON serialisable")

@@ -1,0 +1,301 @@
+"""CreasePattern: a validated 2D crease pattern (first box of the data flow).
+
+Units: coordinates, widths in mm; angles in degrees, valley positive (FOLD).
+"""
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+
+from .errors import PatternError, PatternWarning
+from .planar import crossing_pairs, derive_faces, signed_area
+
+#: Assignments foldcore simulates. ``C`` (cut) and ``J`` (join) are refused.
+ASSIGNMENTS = ("M", "V", "B", "F", "U")
+DEFAULT_MAX_ANGLE_DEG = 180.0
+
+
+class CreasePattern:
+    """A flat crease pattern with per-edge fold data, validated on construction.
+
+    Parameters
+    ----------
+    vertices : (V, 2) array_like of float
+        Vertex coordinates in the flat sheet, mm.
+    edges : (E, 2) array_like of int
+        Vertex ids of each edge.
+    assignments : (E,) sequence of str
+        ``M`` mountain, ``V`` valley, ``B`` boundary, ``F`` flat (held at 0°),
+        ``U`` unassigned (passive, either direction).
+    fold_angles : (E,) array_like of float or None, optional
+        Target fold angle per edge in degrees, valley positive. ``None``/NaN
+        means passive (the crease folds as the mechanism dictates). Default:
+        all passive.
+    widths : (E,) array_like of float or None, optional
+        Hinge width per crease in mm; NaN means "choose from Eq. 7 when the
+        mesh is thickened". Default: all NaN.
+    max_angles : (E,) array_like of float or None, optional
+        Largest fold magnitude per crease in degrees, in (0, 180]. Default 180.
+    faces : sequence of (n,) int arrays, optional
+        Panels as vertex loops. Derived from the planar graph when omitted.
+        Clockwise loops are reversed with a :class:`PatternWarning`.
+    source : str, optional
+        File name (or description) used in every error message.
+
+    Raises
+    ------
+    PatternError
+        On any malformed input; the message names the offending item.
+    """
+
+    def __init__(self, vertices, edges, assignments, fold_angles=None, widths=None,
+                 max_angles=None, faces=None, source: str = "<pattern>"):
+        self.source = source
+        self.vertices = _frozen(_as_vertices(vertices, source))
+        self.edges = _frozen(_as_edges(edges, len(self.vertices), source))
+        n_edges = len(self.edges)
+        self.assignments = _frozen(_as_assignments(assignments, n_edges, source))
+        self.fold_angles = _frozen(_per_edge(fold_angles, n_edges, np.nan, "fold_angles", source))
+        self.widths = _frozen(_per_edge(widths, n_edges, np.nan, "widths", source))
+        self.max_angles = _frozen(_per_edge(max_angles, n_edges, DEFAULT_MAX_ANGLE_DEG,
+                                            "max_angles", source))
+        self._validate_edges()
+        self._validate_edge_values()
+        boundary = self.assignments == "B"
+        if faces is None:
+            faces = derive_faces(self.vertices, self.edges, boundary, source)
+        else:
+            faces = self._counter_clockwise(faces)
+        self.faces = tuple(_frozen(f) for f in faces)
+        self.edge_faces = _frozen(self._match_faces())
+
+    # ----------------------------------------------------------------- queries
+    @property
+    def n_vertices(self) -> int:
+        return len(self.vertices)
+
+    @property
+    def n_edges(self) -> int:
+        return len(self.edges)
+
+    @property
+    def creases(self) -> np.ndarray:
+        """(C,) int: ids of the edges that become hinges (every non-``B`` edge)."""
+        return np.flatnonzero(self.assignments != "B")
+
+    @property
+    def actuated(self) -> np.ndarray:
+        """(E,) bool: edges with a target fold angle (``F`` edges count, at 0°)."""
+        return ~np.isnan(self.fold_angles) | (self.assignments == "F")
+
+    def edge_lengths(self) -> np.ndarray:
+        """(E,) float: edge lengths in mm."""
+        d = self.vertices[self.edges[:, 1]] - self.vertices[self.edges[:, 0]]
+        return np.hypot(d[:, 0], d[:, 1])
+
+    def area(self) -> float:
+        """Sheet area in mm² (sum of the faces)."""
+        return sum(signed_area(self.vertices[f]) for f in self.faces)
+
+    def replace(self, **changes) -> "CreasePattern":
+        """A copy with some per-edge arrays replaced (re-validated)."""
+        args = dict(vertices=self.vertices, edges=self.edges, assignments=self.assignments,
+                    fold_angles=self.fold_angles, widths=self.widths,
+                    max_angles=self.max_angles, faces=list(self.faces), source=self.source)
+        args.update(changes)
+        return CreasePattern(**args)
+
+    def __repr__(self) -> str:
+        counts = {a: int(np.count_nonzero(self.assignments == a)) for a in ASSIGNMENTS}
+        summary = " ".join(f"{a}={n}" for a, n in counts.items() if n)
+        return (f"CreasePattern({self.source!r}: {self.n_vertices} vertices, "
+                f"{self.n_edges} edges [{summary}], {len(self.faces)} faces)")
+
+    # -------------------------------------------------------------- validation
+    def _fail(self, message: str):
+        raise PatternError(f"{self.source}: {message}")
+
+    def _validate_edges(self):
+        lengths = self.edge_lengths()
+        scale = float(np.ptp(self.vertices, axis=0).max()) if self.n_vertices else 0.0
+        for i in np.flatnonzero(lengths <= 1e-12 * max(scale, 1e-300)):
+            self._fail(f"edge {i} {tuple(self.edges[i].tolist())} has zero length")
+        pairs = np.sort(self.edges, axis=1)
+        _, first, counts = np.unique(pairs, axis=0, return_index=True, return_counts=True)
+        for i in first[counts > 1]:
+            j = np.flatnonzero((pairs == pairs[i]).all(axis=1))[1]
+            self._fail(f"edge {j} duplicates edge {i} (vertices {tuple(self.edges[i].tolist())})")
+        degree = np.bincount(self.edges.ravel(), minlength=self.n_vertices)
+        for v in np.flatnonzero(degree == 0):
+            self._fail(f"vertex {v} is not on any edge")
+        for v in np.flatnonzero(degree == 1):
+            e = int(np.flatnonzero((self.edges == v).any(axis=1))[0])
+            self._fail(f"edge {e} is dangling (vertex {v} has no other edge)")
+        self._validate_connected()
+        for i, j in crossing_pairs(self.vertices, self.edges):
+            self._fail(f"edges {i} and {j} cross or overlap")
+
+    def _validate_connected(self):
+        from scipy.sparse import coo_matrix
+        from scipy.sparse.csgraph import connected_components
+
+        n = self.n_vertices
+        graph = coo_matrix((np.ones(self.n_edges), (self.edges[:, 0], self.edges[:, 1])),
+                           shape=(n, n))
+        n_pieces, label = connected_components(graph, directed=False)
+        if n_pieces > 1:
+            v = int(np.flatnonzero(label != label[0])[0])
+            e = int(np.flatnonzero((self.edges == v).any(axis=1))[0])
+            self._fail(f"the pattern is not connected ({n_pieces} separate pieces): vertex "
+                       f"{v} (edge {e}) is not connected to vertex 0; simulate each piece "
+                       "on its own")
+
+    def _validate_edge_values(self):
+        for e, (kind, angle) in enumerate(zip(self.assignments, self.fold_angles)):
+            if np.isnan(angle):
+                continue
+            if abs(angle) > 180.0:
+                self._fail(f"edge {e}: fold angle {angle:g}° is outside [-180, 180]")
+            if kind == "M" and angle > 0 or kind == "V" and angle < 0:
+                self._fail(f"edge {e}: fold angle {angle:g}° contradicts assignment "
+                           f"{str(kind)!r} (valley > 0, mountain < 0)")
+            if kind in "BF" and angle != 0:
+                self._fail(f"edge {e}: fold angle {angle:g}° on a {str(kind)!r} edge "
+                           "(must be 0 or passive)")
+        bad_w = ~np.isnan(self.widths) & ~(self.widths > 0)
+        for e in np.flatnonzero(bad_w):
+            self._fail(f"edge {e}: hinge width {self.widths[e]:g} mm must be > 0")
+        bad_m = ~((self.max_angles > 0) & (self.max_angles <= 180))
+        for e in np.flatnonzero(bad_m):
+            self._fail(f"edge {e}: max angle {self.max_angles[e]:g}° must be in (0, 180]")
+        for e in np.flatnonzero(np.abs(np.nan_to_num(self.fold_angles)) > self.max_angles + 1e-9):
+            self._fail(f"edge {e}: fold angle {self.fold_angles[e]:g}° exceeds its "
+                       f"max angle {self.max_angles[e]:g}°")
+
+    def _counter_clockwise(self, faces) -> list[np.ndarray]:
+        out = []
+        for i, face in enumerate(faces):
+            face = np.asarray(face, dtype=np.int64).ravel()
+            if len(face) < 3:
+                self._fail(f"face {i} has {len(face)} vertices (needs at least 3)")
+            if face.min() < 0 or face.max() >= self.n_vertices:
+                self._fail(f"face {i} refers to a vertex out of range 0..{self.n_vertices - 1}")
+            area = signed_area(self.vertices[face])
+            if abs(area) <= 0:
+                self._fail(f"face {i} has zero area")
+            if area < 0:
+                warnings.warn(f"{self.source}: face {i} was clockwise; reversed to "
+                              "counter-clockwise", PatternWarning, stacklevel=4)
+                face = face[::-1].copy()
+            out.append(face)
+        return out
+
+    def _match_faces(self) -> np.ndarray:
+        """(E, 2) int: face on the left / right of each edge (u→v), −1 if none."""
+        key = {(int(u), int(v)): (e, 0) for e, (u, v) in enumerate(self.edges)}
+        key.update({(int(v), int(u)): (e, 1) for e, (u, v) in enumerate(self.edges)})
+        edge_faces = np.full((self.n_edges, 2), -1, dtype=np.int64)
+        for f, face in enumerate(self.faces):
+            for u, v in zip(face, np.roll(face, -1)):
+                if (int(u), int(v)) not in key:
+                    self._fail(f"face {f}: its side {int(u)}→{int(v)} is not an edge")
+                e, side = key[(int(u), int(v))]
+                if edge_faces[e, side] >= 0:
+                    self._fail(f"edge {e} has faces {edge_faces[e, side]} and {f} on the "
+                               "same side (overlapping faces)")
+                edge_faces[e, side] = f
+        n_sides = (edge_faces >= 0).sum(axis=1)
+        for e in np.flatnonzero(n_sides == 0):
+            self._fail(f"edge {e} belongs to no face")
+        for e in np.flatnonzero((n_sides == 1) & (self.assignments != "B")):
+            self._fail(f"edge {e} is assigned {str(self.assignments[e])!r} but lies on the "
+                       "sheet boundary (only one face); assign it 'B'")
+        for e in np.flatnonzero((n_sides == 2) & (self.assignments == "B")):
+            self._fail(f"edge {e} is assigned 'B' but has faces on both sides")
+        return edge_faces
+
+
+# ------------------------------------------------------------------ coercion
+def _frozen(a: np.ndarray) -> np.ndarray:
+    a = np.ascontiguousarray(a)
+    a.setflags(write=False)
+    return a
+
+
+def _as_vertices(vertices, source: str) -> np.ndarray:
+    try:
+        v = np.asarray(vertices, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise PatternError(f"{source}: vertices are not numbers ({exc})") from None
+    if v.ndim != 2 or v.shape[1] not in (2, 3):
+        raise PatternError(f"{source}: vertices must be an (V, 2) array, got shape {v.shape}")
+    if v.shape[1] == 3:
+        off = np.flatnonzero(v[:, 2] != 0)
+        if len(off):
+            raise PatternError(f"{source}: vertex {off[0]} has z = {v[off[0], 2]:g}; "
+                               "a crease pattern must be flat (z = 0)")
+        v = v[:, :2]
+    bad = np.flatnonzero(~np.isfinite(v).all(axis=1))
+    if len(bad):
+        raise PatternError(f"{source}: vertex {bad[0]} has a non-finite coordinate "
+                           f"{tuple(v[bad[0]].tolist())}")
+    return v
+
+
+def _as_edges(edges, n_vertices: int, source: str) -> np.ndarray:
+    raw = np.asarray(edges)
+    if raw.size == 0:
+        raise PatternError(f"{source}: the pattern has no edges")
+    if raw.ndim != 2 or raw.shape[1] != 2:
+        raise PatternError(f"{source}: edges must be an (E, 2) array, got shape {raw.shape}")
+    if not np.issubdtype(raw.dtype, np.integer):
+        as_float = np.asarray(raw, dtype=np.float64)
+        bad = np.flatnonzero((as_float != np.round(as_float)).any(axis=1)
+                             | ~np.isfinite(as_float).all(axis=1))
+        if len(bad):
+            raise PatternError(f"{source}: edge {bad[0]} has a non-integer vertex id")
+    e = raw.astype(np.int64)
+    bad = np.flatnonzero(((e < 0) | (e >= n_vertices)).any(axis=1))
+    if len(bad):
+        raise PatternError(f"{source}: edge {bad[0]} refers to vertex "
+                           f"{tuple(e[bad[0]].tolist())} out of range 0..{n_vertices - 1}")
+    loops = np.flatnonzero(e[:, 0] == e[:, 1])
+    if len(loops):
+        raise PatternError(f"{source}: edge {loops[0]} has zero length (both ends are "
+                           f"vertex {e[loops[0], 0]})")
+    return e
+
+
+def _as_assignments(assignments, n_edges: int, source: str) -> np.ndarray:
+    a = [str(x) for x in assignments]
+    if len(a) != n_edges:
+        raise PatternError(f"{source}: {len(a)} assignments for {n_edges} edges")
+    for e, kind in enumerate(a):
+        if kind in ("C", "J"):
+            raise PatternError(f"{source}: edge {e} has assignment {kind!r} "
+                               "(cut/join edges are not supported; split or merge the "
+                               "faces in the pattern instead)")
+        if kind not in ASSIGNMENTS:
+            raise PatternError(f"{source}: edge {e} has unknown assignment {kind!r} "
+                               f"(expected one of {', '.join(ASSIGNMENTS)})")
+    return np.array(a, dtype="<U1")
+
+
+def _per_edge(values, n_edges: int, default: float, name: str, source: str) -> np.ndarray:
+    if values is None:
+        return np.full(n_edges, default, dtype=np.float64)
+    try:
+        out = np.array([np.nan if x is None else x for x in values], dtype=np.float64)
+    except (TypeError, ValueError):
+        raise PatternError(f"{source}: {name} must be numbers or null") from None
+    if out.shape != (n_edges,):
+        raise PatternError(f"{source}: {len(out)} {name} for {n_edges} edges")
+    bad = np.flatnonzero(np.isinf(out))
+    if len(bad):
+        raise PatternError(f"{source}: edge {bad[0]}: {name} is infinite")
+    if default == default:  # a numeric default: NaN is not allowed
+        nan = np.flatnonzero(np.isnan(out))
+        if len(nan):
+            raise PatternError(f"{source}: edge {nan[0]}: {name} is NaN")
+    return out
