@@ -1,0 +1,357 @@
+"""thicken(): crease pattern → ThickMesh (paper §2.2).
+
+Each crease is widened into a strip of its hinge width; the panels are the
+faces offset inward by half the width of each crease side (a mitered offset,
+so each panel corner is the intersection X of two offset lines — Eq. 1 read
+with its arctan); each strip is cut square where the farther of its two
+neighbouring panel corners lies, which decouples strips at vertices and leaves
+holes there. Strips are split across their width into ``k`` sub-strips and
+everything is extruded to thickness ``H`` (mid-plane at z = 0).
+
+Panel outlines get the strip corners inserted (collinear points), so panels and
+strips share vertices on every common face: the mesh is conforming.
+Units: mm, angles in degrees at this API.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from elements.bending_hinge import HINGE_PARAMS
+from .errors import MeshError
+from .mesh import ElementGroup, ThickMesh
+from .pattern import CreasePattern
+
+MAX_SUBDIVISIONS = 16
+
+
+# ----------------------------------------------------------------- parameters
+def minimum_hinge_width(thickness: float, max_angle_deg, bend_radius: float = 0.0):
+    """Eq. 7: hinge width W = (r + H/2)·θmax in mm (θmax given in degrees)."""
+    return (bend_radius + 0.5 * thickness) * np.radians(max_angle_deg)
+
+
+def auto_subdivisions(width, thickness: float, max_angle_deg) -> np.ndarray:
+    """Sub-strips per hinge chosen from its largest fold angle.
+
+    Rule: k = max(2, ceil(θmax / 45°)), then raised (up to 16) while one
+    sub-strip of width W/k cannot reach θmax/k under Eq. 8, whose per-strip
+    limit is 2·atan(W/(k·H)) (top face shrinks to zero length).
+    """
+    width = np.atleast_1d(np.asarray(width, dtype=float))
+    theta = np.radians(np.broadcast_to(max_angle_deg, width.shape))
+    k = np.maximum(2, np.ceil(np.degrees(theta) / 45.0 - 1e-9)).astype(np.int64)
+    for _ in range(MAX_SUBDIVISIONS):
+        short = (theta / k > 2 * np.arctan(width / (k * thickness))) & (k < MAX_SUBDIVISIONS)
+        if not short.any():
+            break
+        k[short] += 1
+    return k
+
+
+def _resolve_widths(pattern, thickness, hinge_width, bend_radius) -> np.ndarray:
+    widths = np.array(pattern.widths, dtype=float)
+    if hinge_width is not None:
+        widths = np.broadcast_to(np.asarray(hinge_width, dtype=float), widths.shape).copy()
+    auto = np.isnan(widths)
+    widths[auto] = minimum_hinge_width(thickness, pattern.max_angles[auto], bend_radius)
+    widths[pattern.assignments == "B"] = np.nan
+    bad = np.flatnonzero(~(widths > 0) & (pattern.assignments != "B"))
+    if len(bad):
+        raise MeshError(f"{pattern.source}: edge {bad[0]}: hinge width must be > 0 mm")
+    return widths
+
+
+def _resolve_subdivisions(pattern, widths, thickness, subdivisions) -> np.ndarray:
+    crease = pattern.assignments != "B"
+    if subdivisions is None or (isinstance(subdivisions, str) and subdivisions == "auto"):
+        k = np.zeros(pattern.n_edges, dtype=np.int64)
+        k[crease] = auto_subdivisions(widths[crease], thickness, pattern.max_angles[crease])
+        return k
+    k = np.broadcast_to(np.asarray(subdivisions), (pattern.n_edges,))
+    if not np.issubdtype(k.dtype, np.integer) or (k[crease] < 1).any():
+        raise MeshError(f"{pattern.source}: subdivisions must be a positive integer or "
+                        f"'auto', got {subdivisions!r}")
+    return np.where(crease, k, 0).astype(np.int64)
+
+
+# ------------------------------------------------------------------- geometry
+def _cross(a, b):
+    return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+
+
+def _left_normal(d):
+    return np.array([-d[1], d[0]])
+
+
+def _inset_corners(pattern, face_id, offsets) -> np.ndarray:
+    """Mitered inward offset of one face: one corner per face vertex.
+
+    ``offsets[i]`` is the inward offset (mm) of the face side leaving vertex i.
+    """
+    face = pattern.faces[face_id]
+    p = pattern.vertices[face]
+    d = np.roll(p, -1, axis=0) - p
+    u = d / np.linalg.norm(d, axis=1)[:, None]
+    n = np.column_stack([-u[:, 1], u[:, 0]])
+    u_in, n_in, off_in = np.roll(u, 1, axis=0), np.roll(n, 1, axis=0), np.roll(offsets, 1)
+    denom = _cross(u_in, u)
+    rhs = offsets[:, None] * n - off_in[:, None] * n_in
+    straight = np.abs(denom) < 1e-9
+    if np.any(straight & (np.abs(offsets - off_in) > 1e-9 * (1 + offsets))):
+        i = int(np.flatnonzero(straight)[0])
+        raise MeshError(f"{pattern.source}: face {face_id}: two collinear sides at vertex "
+                        f"{face[i]} have different hinge widths")
+    t = np.where(straight, 0.0, _cross(rhs, u) / np.where(straight, 1.0, denom))
+    return p + off_in[:, None] * n_in + t[:, None] * u_in
+
+
+def _face_offsets(pattern, widths) -> list[np.ndarray]:
+    """Inward offset (mm) of each side of each face: half its hinge width, 0 on B."""
+    key = {}
+    for e, (a, b) in enumerate(pattern.edges):
+        key[(int(a), int(b))] = key[(int(b), int(a))] = e
+    half = np.nan_to_num(0.5 * widths)
+    return [np.array([half[key[(int(a), int(b))]] for a, b in zip(f, np.roll(f, -1))])
+            for f in pattern.faces]
+
+
+def _check_inset(pattern, face_id, corners):
+    import shapely
+
+    face = pattern.vertices[pattern.faces[face_id]]
+    side_old = np.roll(face, -1, axis=0) - face
+    side_new = np.roll(corners, -1, axis=0) - corners
+    poly = shapely.Polygon(corners)
+    if (np.einsum("ij,ij->i", side_old, side_new) <= 0).any() or not poly.is_valid:
+        raise MeshError(f"{pattern.source}: face {face_id}: hinge widths are too large for "
+                        "this face (its panel would vanish or turn inside out); use narrower "
+                        "hinges or a larger pattern")
+
+
+class _PointTable:
+    """2D points of the thick sheet; ids are allocated as points are added."""
+
+    def __init__(self):
+        self.coords: list[np.ndarray] = []
+
+    def add(self, xy) -> int:
+        self.coords.append(np.asarray(xy, dtype=float))
+        return len(self.coords) - 1
+
+
+def _corner_ids(pattern, widths, table):
+    offsets = _face_offsets(pattern, widths)
+    corners, ids = [], []
+    for f in range(len(pattern.faces)):
+        c = _inset_corners(pattern, f, offsets[f])
+        _check_inset(pattern, f, c)
+        corners.append(c)
+        ids.append([table.add(x) for x in c])
+    return corners, ids
+
+
+def _corner_index(pattern, face_id, vertex) -> int:
+    return int(np.flatnonzero(pattern.faces[face_id] == vertex)[0])
+
+
+def _strip_cuts(pattern, e, corners) -> tuple[float, float]:
+    """Distances (mm) from each crease end to where its strip starts (≥ 0)."""
+    a, b = pattern.edges[e]
+    pa, pb = pattern.vertices[a], pattern.vertices[b]
+    u = (pb - pa) / np.linalg.norm(pb - pa)
+    cuts = []
+    for end, point, direction in ((a, pa, u), (b, pb, -u)):
+        along = [float((corners[f][_corner_index(pattern, f, end)] - point) @ direction)
+                 for f in pattern.edge_faces[e]]
+        cuts.append(max(along + [0.0]))
+    return cuts[0], cuts[1]
+
+
+def _strip_lines(pattern, e, width, k, cuts):
+    """(k+1, 2, 2) array: for each line across the strip, its point at end a and b.
+
+    Line 0 is the left side (left face), line k the right side.
+    """
+    a, b = pattern.edges[e]
+    pa, pb = pattern.vertices[a], pattern.vertices[b]
+    length = float(np.linalg.norm(pb - pa))
+    if cuts[0] + cuts[1] >= length * (1 - 1e-9):
+        raise MeshError(f"{pattern.source}: edge {e} ({length:.6g} mm) is too short for the "
+                        "hinge widths around it; use narrower hinges")
+    u = (pb - pa) / length
+    n = _left_normal(u)
+    ends = np.array([pa + cuts[0] * u, pb - cuts[1] * u])
+    t = 0.5 * width * (1 - 2 * np.arange(k + 1) / k)
+    return ends[None, :, :] + t[:, None, None] * n[None, None, :]
+
+
+# ---------------------------------------------------------------- assembling
+def _close(p, q, scale) -> bool:
+    return float(np.linalg.norm(p - q)) <= 1e-9 * scale
+
+
+def _attach_strip_sides(pattern, e, lines, corners, corner_ids, table, inserts, scale):
+    """Ids of the strip's side points, shared with (or inserted into) its panels."""
+    a, b = pattern.edges[e]
+    f_left, f_right = pattern.edge_faces[e]
+    side_ids = {}
+    for side, face, (first, second) in ((0, f_left, (a, b)), (len(lines) - 1, f_right, (b, a))):
+        i = _corner_index(pattern, face, first)
+        j = (i + 1) % len(pattern.faces[face])
+        pts = lines[side] if side == 0 else lines[side][::-1]
+        got = []
+        for point, corner in zip(pts, (i, j)):
+            if _close(point, corners[face][corner], scale):
+                got.append(corner_ids[face][corner])
+            else:
+                got.append(table.add(point))
+                inserts[face].setdefault(i, []).append(got[-1])
+        side_ids[side] = got if side == 0 else got[::-1]
+    return side_ids
+
+
+def thicken(pattern: CreasePattern, thickness: float, hinge_width=None,
+            subdivisions="auto", bend_radius: float = 0.0, exact_arc: bool = True,
+            stiffness=None) -> ThickMesh:
+    """Build the thick prism mesh of a crease pattern (paper §2.2).
+
+    Parameters
+    ----------
+    pattern : CreasePattern
+    thickness : float
+        Sheet thickness H, mm (> 0).
+    hinge_width : float or (E,) array, optional
+        Hinge width W per edge, mm; overrides the pattern's widths when given.
+        NaN entries (and the default for patterns without widths) use Eq. 7,
+        W = (r + H/2)·θmax, with r = ``bend_radius`` and θmax the edge's max angle.
+    subdivisions : int, (E,) ints or "auto"
+        Sub-strips per hinge; "auto" uses :func:`auto_subdivisions`.
+    bend_radius : float
+        Inner bend radius r for automatic widths, mm.
+    exact_arc : bool
+        Hinge targets on the exact circular arc (True) or Eq. 8's trapezoids.
+    stiffness : dict, optional
+        ``{"panel": (F,) or float, "hinge": (E,) or float}`` stiffness factors
+        multiplying the volume weights (dimensionless, default 1).
+
+    Returns
+    -------
+    ThickMesh
+    """
+    if not (np.isfinite(thickness) and thickness > 0):
+        raise MeshError(f"{pattern.source}: thickness must be a positive number of mm, "
+                        f"got {thickness}")
+    widths = _resolve_widths(pattern, thickness, hinge_width, bend_radius)
+    ks = _resolve_subdivisions(pattern, widths, thickness, subdivisions)
+    table = _PointTable()
+    corners, corner_ids = _corner_ids(pattern, widths, table)
+    inserts: list[dict] = [dict() for _ in pattern.faces]
+    scale = float(np.ptp(pattern.vertices, axis=0).max())
+    strip_points = {}
+    for e in pattern.creases:
+        lines = _strip_lines(pattern, e, widths[e], ks[e], _strip_cuts(pattern, e, corners))
+        sides = _attach_strip_sides(pattern, e, lines, corners, corner_ids, table, inserts, scale)
+        inner = [[table.add(lines[j, 0]), table.add(lines[j, 1])] for j in range(1, ks[e])]
+        strip_points[int(e)] = [sides[0]] + inner + [sides[ks[e]]]
+    points = np.array(table.coords)
+    stiff = stiffness or {}
+    panels = _panel_group(pattern, points, corner_ids, inserts, thickness,
+                          stiff.get("panel", 1.0))
+    hinges, strips_of = _hinge_group(pattern, points, strip_points, widths, ks, thickness,
+                                     exact_arc, stiff.get("hinge", 1.0))
+    return ThickMesh(points=points, thickness=float(thickness),
+                     groups={"rigid_panel": panels, "bending_hinge": hinges},
+                     panel_of_face=np.arange(len(pattern.faces), dtype=np.int64),
+                     strips_of_crease=strips_of, hinge_width=widths, subdivisions=ks)
+
+
+def _prism(ids2d, points, thickness):
+    """Vertex ids (top loop, bottom loop) and rest coordinates (centred, world frame)."""
+    ids2d = np.asarray(ids2d, dtype=np.int64)
+    xy = points[ids2d]
+    h = 0.5 * thickness
+    xyz = np.vstack([np.column_stack([xy, np.full(len(xy), h)]),
+                     np.column_stack([xy, np.full(len(xy), -h)])])
+    return ids2d, xyz - xyz.mean(axis=0)
+
+
+def _panel_group(pattern, points, corner_ids, inserts, thickness, stiffness):
+    loops, rests, vols = [], [], []
+    n_top = len(points)
+    for f, ids in enumerate(corner_ids):
+        loop = []
+        for i, cid in enumerate(ids):
+            loop.append(cid)
+            loop += inserts[f].get(i, [])
+        loop2d, rest = _prism(loop, points, thickness)
+        loops.append(np.concatenate([loop2d, loop2d + n_top]))
+        rests.append(rest)
+        vols.append(_polygon_area(points[loop2d]) * thickness)
+    vols = np.array(vols)
+    return _group("rigid_panel", loops, rests, np.zeros((len(loops), 0)), vols,
+                  vols * np.broadcast_to(stiffness, vols.shape),
+                  np.arange(len(loops), dtype=np.int64))
+
+
+def _polygon_area(xy) -> float:
+    return 0.5 * float(_cross(xy, np.roll(xy, -1, axis=0)).sum())
+
+
+def _hinge_group(pattern, points, strip_points, widths, ks, thickness, exact_arc, stiffness):
+    n_top = len(points)
+    loops, rests, params, vols, source, strips_of = [], [], [], [], [], {}
+    stiff_e = np.broadcast_to(np.asarray(stiffness, dtype=float), (pattern.n_edges,))
+    sign = {"V": 1.0, "M": -1.0, "U": 0.0, "F": 0.0}
+    for e, lines in strip_points.items():
+        k = int(ks[e])
+        frame = _hinge_frame(pattern, e)
+        target = pattern.fold_angles[e]
+        if pattern.assignments[e] == "F":
+            target = 0.0
+        strips_of[e] = np.arange(len(loops), len(loops) + k, dtype=np.int64)
+        length = float(np.linalg.norm(points[lines[0][1]] - points[lines[0][0]]))
+        for j in range(k):
+            quad = [lines[j][0], lines[j + 1][0], lines[j + 1][1], lines[j][1]]
+            loop2d, rest = _prism(quad, points, thickness)
+            loops.append(np.concatenate([loop2d, loop2d + n_top]))
+            rests.append(rest @ frame)
+            params.append(_hinge_params(widths[e] / k, thickness, target, k,
+                                        sign[pattern.assignments[e]],
+                                        pattern.max_angles[e], exact_arc))
+            vols.append(widths[e] / k * length * thickness)
+            source.append(e)
+    vols = np.array(vols)
+    src = np.array(source, dtype=np.int64)
+    return _group("bending_hinge", loops, rests, np.array(params).reshape(len(loops), -1),
+                  vols, vols * stiff_e[src] if len(src) else vols, src), strips_of
+
+
+def _hinge_frame(pattern, e) -> np.ndarray:
+    """(3, 3) columns: local x (across, toward the left face), y (up), z (along a→b)."""
+    a, b = pattern.edges[e]
+    d = pattern.vertices[b] - pattern.vertices[a]
+    u = np.r_[d / np.linalg.norm(d), 0.0]
+    return np.column_stack([np.cross([0.0, 0.0, 1.0], u), [0.0, 0.0, 1.0], u])
+
+
+def _hinge_params(width, thickness, target_deg, k, sign, max_deg, exact_arc):
+    p = np.zeros(len(HINGE_PARAMS))  # floor stays 0 (set by Simulation)
+    p[HINGE_PARAMS.index("width")] = width
+    p[HINGE_PARAMS.index("height")] = thickness
+    p[HINGE_PARAMS.index("target")] = np.radians(target_deg) / k
+    p[HINGE_PARAMS.index("sign")] = sign
+    p[HINGE_PARAMS.index("max_angle")] = np.radians(max_deg) / k
+    p[HINGE_PARAMS.index("exact_arc")] = float(exact_arc)
+    return p
+
+
+def _group(kind, loops, rests, params, volumes, weights, source) -> ElementGroup:
+    sizes = np.array([len(x) for x in loops], dtype=np.int64)
+    indptr = np.zeros(len(loops) + 1, dtype=np.int64)
+    np.cumsum(sizes, out=indptr[1:])
+    indices = np.concatenate(loops) if loops else np.zeros(0, np.int64)
+    rest = np.vstack(rests) if rests else np.zeros((0, 3))
+    return ElementGroup(kind, indptr, indices.astype(np.int64), np.ascontiguousarray(rest),
+                        np.ascontiguousarray(params, dtype=np.float64),
+                        np.asarray(volumes, dtype=float), np.asarray(weights, dtype=float),
+                        source)
