@@ -1,0 +1,140 @@
+"""Bending hinge sub-strip: a 4-sided prism bent about its long axis (paper §4.1–4.3).
+
+Vertex order and local frame (x across the width toward the left panel, y up
+through the thickness, z along the crease from its end a to end b)::
+
+     top (y = +H/2)            bottom (y = -H/2)
+      3 ───────── 2             7 ───────── 6      end b
+      │           │             │           │
+      0 ───────── 1             4 ───────── 5      end a
+     left       right
+
+Parameters (columns of ``params``, angles per sub-strip in radians):
+
+* ``width`` W and ``height`` H of the rest strip, mm;
+* ``target`` bend angle φ (valley > 0), NaN for a passive strip;
+* ``sign`` +1 valley, −1 mountain, 0 unassigned (passive strips are clamped to
+  their sign's side, §4.2);
+* ``max_angle`` largest |φ| (§4.3); ``floor`` smallest |φ| a passive M/V strip
+  is given when its estimate has the wrong sign;
+* ``exact_arc`` 1: target on the circular arc of the neutral axis (exact
+  bending), 0: Eq. 8's trapezoid (end faces sheared, error O(φ²)).
+
+A passive strip's angle is estimated from its current shape by Eq. 9,
+θ = 2·atan((W_b − W_t) / (2 H_p)), with H_p the *perpendicular* height
+√(s² − ((W_b − W_t)/2)²) recovered from the mean end-face length s (the end
+faces of an Eq. 8 trapezoid are slanted, s = H / cos(θ/2); the paper's H_p = s
+would return 2·atan(sin(θ/2)) instead of θ). Equivalently θ = 2·asin((W_b − W_t)
+/ (2s)), which also inverts the exact arc (radial end faces, s = H), so both
+targets are fixed points of their own estimate. The angle used is written to
+``state[0]``.
+"""
+import math
+
+import numpy as np
+from numba import njit, prange
+
+from ._registry import ElementType
+from ._rotation import fit_rotated
+
+HINGE_PARAMS = ("width", "height", "target", "sign", "max_angle", "floor", "exact_arc")
+W, H, TARGET, SIGN, MAX_ANGLE, FLOOR, EXACT = range(len(HINGE_PARAMS))
+
+
+@njit(cache=True)
+def _dist(x, i, j):
+    return math.sqrt((x[i, 0] - x[j, 0]) ** 2 + (x[i, 1] - x[j, 1]) ** 2
+                     + (x[i, 2] - x[j, 2]) ** 2)
+
+
+@njit(cache=True)
+def estimate_angle(x, ids):
+    """Bend angle (rad, valley > 0) of a strip from its current shape (Eq. 9).
+
+    H_p is the perpendicular height √(s² − d²), s the mean end-face length and
+    d = (W_b − W_t)/2, so Eq. 8 trapezoids and exact arcs both return their θ.
+    """
+    w_top = 0.5 * (_dist(x, ids[0], ids[1]) + _dist(x, ids[3], ids[2]))
+    w_bot = 0.5 * (_dist(x, ids[4], ids[5]) + _dist(x, ids[7], ids[6]))
+    s = 0.25 * (_dist(x, ids[0], ids[4]) + _dist(x, ids[1], ids[5])
+                + _dist(x, ids[2], ids[6]) + _dist(x, ids[3], ids[7]))
+    d = 0.5 * (w_bot - w_top)
+    return 2.0 * math.atan2(d, math.sqrt(max(s * s - d * d, 0.0)))
+
+
+@njit(cache=True)
+def clamp_angle(phi, sign, floor, max_angle):
+    """Project a passive strip's angle onto its allowed interval (§4.2–4.3)."""
+    if sign > 0.0:
+        return min(max(phi, floor), max_angle)
+    if sign < 0.0:
+        return max(min(phi, -floor), -max_angle)
+    return min(max(phi, -max_angle), max_angle)
+
+
+@njit(cache=True)
+def bent_shape(rest, width, phi, exact_arc, out):
+    """Write the strip bent by ``phi`` (rad) into ``out`` (m, 3), centred, local frame."""
+    m = rest.shape[0]
+    kappa = phi / width
+    for k in range(m):
+        x, y, z = rest[k, 0], rest[k, 1], rest[k, 2]
+        if not exact_arc:
+            out[k, 0] = x * (1.0 - 2.0 * y / width * math.tan(0.5 * phi))
+            out[k, 1] = y
+        elif abs(kappa) * width < 1e-12:
+            out[k, 0] = x
+            out[k, 1] = y
+        else:
+            psi = kappa * x
+            out[k, 0] = (1.0 - kappa * y) * math.sin(psi) / kappa
+            out[k, 1] = 2.0 * math.sin(0.5 * psi) ** 2 / kappa + y * math.cos(psi)
+        out[k, 2] = z
+    for d in range(2):
+        mean = 0.0
+        for k in range(m):
+            mean += out[k, d]
+        for k in range(m):
+            out[k, d] -= mean / m
+
+
+@njit(cache=True)
+def project(x, ids, rest, params, out, state):
+    """Rotated bent target of one sub-strip; returns its residual (mm²).
+
+    Parameters
+    ----------
+    x : (N, 3) current positions, mm
+    ids : (8,) vertex ids in the order drawn in the module docstring
+    rest : (8, 3) centred rest shape in the local frame, mm
+    params : (7,) see ``HINGE_PARAMS``
+    out : (8, 3) written: the rotated target, mm (also used as scratch)
+    state : (1,) written: the bend angle used, rad
+    """
+    exact = params[EXACT] > 0.5
+    phi = params[TARGET]
+    if math.isnan(phi):
+        phi = clamp_angle(estimate_angle(x, ids), params[SIGN], params[FLOOR],
+                          params[MAX_ANGLE])
+    state[0] = phi
+    bent_shape(rest, params[W], phi, exact, out)
+    target = out.copy()
+    return fit_rotated(x, ids, target, out)
+
+
+@njit(parallel=True, cache=True)
+def batch(x, indptr, indices, rest, params, out, energy, state):
+    """Project every sub-strip; ``energy[e]`` residual (mm²), ``state[e, 0]`` angle (rad)."""
+    for e in prange(len(indptr) - 1):
+        s, t = indptr[e], indptr[e + 1]
+        energy[e] = project(x, indices[s:t], rest[s:t], params[e], out[s:t], state[e])
+
+
+class BendingHinge(ElementType):
+    """Hinge sub-strip bent to a target (actuated) or estimated (passive) angle."""
+
+    name = "bending_hinge"
+    params = HINGE_PARAMS
+    state = ("angle",)
+    batch = batch
+    project = project

@@ -1,0 +1,144 @@
+"""Slow, obviously-correct NumPy twins of every element kernel (STUMPY style).
+
+Written from the equations (paper §4, DESIGN.md), not from the numba code: the
+tests compare each registered kernel against the twin of the same name.
+Units: mm, radians.
+"""
+import numpy as np
+
+HINGE_PARAMS = ("width", "height", "target", "sign", "max_angle", "floor", "exact_arc")
+
+
+def kabsch(p, t):
+    """Rotation R (det +1) minimising Σ‖p_k − R t_k‖² for centred (m, 3) p, t."""
+    u, _, vt = np.linalg.svd(p.T @ t)
+    d = np.sign(np.linalg.det(u @ vt))
+    return u @ np.diag([1.0, 1.0, d]) @ vt
+
+
+def fit(x_elem, target):
+    """Centre both shapes, rotate the target onto x: (out (m, 3), energy mm²)."""
+    p = x_elem - x_elem.mean(axis=0)
+    t = target - target.mean(axis=0)
+    out = t @ kabsch(p, t).T
+    return out, float(np.sum((p - out) ** 2))
+
+
+def rigid_panel(x_elem, rest):
+    """Rigid panel: the rest shape rotated onto the current one."""
+    return fit(np.asarray(x_elem, float), np.asarray(rest, float))
+
+
+# ------------------------------------------------------------ bending hinge
+def strip_measures(x):
+    """(W_t, W_b, H_p) of an (8, 3) strip, vertex order 0-1-2-3 top, 4-7 below."""
+    n = lambda i, j: np.linalg.norm(x[i] - x[j])
+    w_top = (n(0, 1) + n(3, 2)) / 2
+    w_bot = (n(4, 5) + n(7, 6)) / 2
+    h_p = (n(0, 4) + n(1, 5) + n(2, 6) + n(3, 7)) / 4
+    return w_top, w_bot, h_p
+
+
+def estimate_angle(x, exact_arc):
+    """Eq. 9 with the trapezoid's perpendicular height; asin form for the arc."""
+    w_top, w_bot, h_p = strip_measures(x)
+    d = (w_bot - w_top) / 2
+    if exact_arc:
+        return 2 * np.arcsin(np.clip(d / h_p, -1.0, 1.0))
+    h_perp = np.sqrt(max(h_p ** 2 - d ** 2, 0.0))
+    if h_perp == 0.0:
+        return np.copysign(np.pi, d)
+    return 2 * np.arctan(d / h_perp)
+
+
+def clamp(phi, sign, floor, max_angle):
+    """Allowed interval: valley [floor, max], mountain [−max, −floor], else ±max."""
+    lo, hi = {1: (floor, max_angle), -1: (-max_angle, -floor)}.get(
+        int(np.sign(sign)), (-max_angle, max_angle))
+    return float(min(max(phi, lo), hi))
+
+
+def trapezoid(rest, width, phi):
+    """Eq. 8: x ← x·(1 − 2y/W·tan(φ/2))."""
+    out = rest.copy()
+    out[:, 0] = rest[:, 0] * (1 - 2 * rest[:, 1] / width * np.tan(phi / 2))
+    return out
+
+
+def arc(rest, width, phi):
+    """Points on the circular arc of the neutral axis, κ = φ/W (φ = 0: rest)."""
+    if phi == 0.0:
+        return rest.copy()
+    k = phi / width
+    x, y, z = rest.T
+    # (1 − cos κx)/κ written as 2 sin²(κx/2)/κ: no cancellation for small κ
+    return np.column_stack([(1 / k - y) * np.sin(k * x),
+                            2 * np.sin(k * x / 2) ** 2 / k + y * np.cos(k * x), z])
+
+
+def bent_target(rest, width, phi, exact_arc):
+    """The strip bent by φ (rad), centred, in its local frame."""
+    rest = np.asarray(rest, float)
+    out = arc(rest, width, phi) if exact_arc else trapezoid(rest, width, phi)
+    return out - out.mean(axis=0)
+
+
+def hinge_angle(x_elem, params):
+    """Bend angle used by a strip: its target, or the clamped Eq. 9 estimate."""
+    p = dict(zip(HINGE_PARAMS, params))
+    if not np.isnan(p["target"]):
+        return float(p["target"])
+    phi = estimate_angle(x_elem, p["exact_arc"] > 0.5)
+    return clamp(phi, p["sign"], p["floor"], p["max_angle"])
+
+
+def bending_hinge(x_elem, rest, params):
+    """(out (8, 3), energy mm², angle rad) of one hinge sub-strip."""
+    x_elem = np.asarray(x_elem, float)
+    phi = hinge_angle(x_elem, params)
+    target = bent_target(rest, params[0], phi, params[6] > 0.5)
+    out, energy = fit(x_elem, target)
+    return out, energy, phi
+
+
+# ----------------------------------------------------------------- drivers
+def _rigid_panel_element(x_elem, rest, params):
+    out, energy = rigid_panel(x_elem, rest)
+    return out, energy, ()
+
+
+def _bending_hinge_element(x_elem, rest, params):
+    out, energy, phi = bending_hinge(x_elem, rest, params)
+    return out, energy, (phi,)
+
+
+NAIVE = {"rigid_panel": _rigid_panel_element, "bending_hinge": _bending_hinge_element}
+
+
+def project_group(etype_name, x, group_like, params=None):
+    """Loop a group's elements in Python with the twin of ``etype_name``.
+
+    Parameters
+    ----------
+    etype_name : str
+        Registered element type name (a key of ``NAIVE``).
+    x : (N, 3) current positions, mm
+    group_like : object with ``indptr``, ``indices``, ``rest``, ``params``
+    params : (n, p) array, optional
+        Overrides ``group_like.params``.
+
+    Returns
+    -------
+    out (nnz, 3), energy (n,), state (n, s)
+    """
+    element = NAIVE[etype_name]
+    params = group_like.params if params is None else params
+    ptr = group_like.indptr
+    out = np.zeros((len(group_like.indices), 3))
+    energy = np.zeros(len(ptr) - 1)
+    state = []
+    for e in range(len(ptr) - 1):
+        s = slice(ptr[e], ptr[e + 1])
+        out[s], energy[e], st = element(x[group_like.indices[s]], group_like.rest[s], params[e])
+        state.append(st)
+    return out, energy, np.array(state, dtype=float).reshape(len(energy), -1)

@@ -1,0 +1,415 @@
+"""Contract tests over every registered element type (scikit-fem / STUMPY style).
+
+Every type in ``elements.available()`` must have a spec in ``SPECS`` (how to
+pose its rest, live and random parameters) and a NumPy twin in
+``tests/naive.py``; a type without them fails here on purpose.
+
+States come in two kinds: ``mesh`` (a thickened pattern, shared vertices,
+perturbed) and ``soup`` (every element on its own vertices, randomly bent,
+rotated and moved, random parameters: wrong-side M/V estimates and angles
+beyond ``max_angle`` included). Tolerances are relative to element size.
+Units: mm, radians.
+"""
+from __future__ import annotations
+
+import functools
+import math
+import warnings
+from dataclasses import dataclass
+from types import SimpleNamespace
+from typing import Callable
+
+import numba
+import numpy as np
+import pytest
+
+import elements
+import naive
+from elements import _registry
+from foldcore import patterns
+from foldcore.system import gather, vertex_slots
+from foldcore.thicken import thicken
+
+W, H, TARGET, SIGN, MAX_ANGLE, FLOOR, EXACT = range(7)
+TYPES = elements.available()
+KINDS = ("mesh", "soup")
+RTOL = 1e-12
+
+
+# ------------------------------------------------------------------ scenes
+@functools.lru_cache(maxsize=None)
+def scenes() -> dict:
+    """Small realistic thick meshes: actuated / passive V, M, U; arc and Eq. 8."""
+    sh = patterns.single_hinge
+    return {
+        "hinge_act_arc": thicken(sh(angle=90.0, width=4.0), 1.0, subdivisions=4),
+        "hinge_act_M_eq8": thicken(sh(angle=-60.0, assignment="M", width=3.0), 1.0,
+                                   subdivisions=3, exact_arc=False),
+        "hinge_V_arc": thicken(sh(assignment="V", width=2.0, max_angle=120.0), 0.5,
+                               subdivisions=2),
+        "hinge_M_eq8": thicken(sh(assignment="M", width=2.0), 0.5, subdivisions=2,
+                               exact_arc=False),
+        "hinge_U_arc": thicken(sh(assignment="U", width=2.0), 0.5, subdivisions=3),
+        "hinge_U_eq8": thicken(sh(assignment="U", width=2.0), 0.5, subdivisions=3,
+                               exact_arc=False),
+        "degree4_arc": thicken(patterns.degree4_vertex(rho1=40.0), 2.0),
+        "degree4_B_eq8": thicken(patterns.degree4_vertex(mode="B", rho1=-30.0), 2.0,
+                                 exact_arc=False),
+    }
+
+
+# ------------------------------------------------------------- type specs
+def _same(p, rng=None):
+    return p.copy()
+
+
+def _rest_shape(rest, params, rng):
+    return rest.copy()
+
+
+def _hinge_rest(p, rng=None):
+    """Actuated strips → target 0; passive strips keep NaN with floor 0."""
+    p = p.copy()
+    p[~np.isnan(p[:, TARGET]), TARGET] = 0.0
+    p[:, FLOOR] = 0.0
+    return p
+
+
+def _hinge_live(p, rng=None):
+    p = p.copy()
+    p[:, FLOOR] = 0.02
+    return p
+
+
+def _hinge_random(p, rng):
+    p, n = p.copy(), len(p)
+    p[:, SIGN] = rng.choice([-1.0, 0.0, 1.0], n)
+    p[:, MAX_ANGLE] = rng.uniform(0.1, 1.5, n)
+    p[:, FLOOR] = rng.uniform(0.0, 0.08, n)
+    p[:, EXACT] = rng.integers(0, 2, n)
+    p[:, TARGET] = np.where(rng.random(n) < 0.3, rng.uniform(-1.5, 1.5, n), np.nan)
+    return p
+
+
+def _hinge_bent(rest, params, rng):
+    return naive.bent_target(rest, params[W], rng.uniform(-2.6, 2.6), params[EXACT] > 0.5)
+
+
+@dataclass(frozen=True)
+class Spec:
+    rest_params: Callable     # params under which the rest shape is a fixed point
+    live_params: Callable     # params for perturbed mesh states
+    random_params: Callable   # (params, rng) → random valid params
+    random_shape: Callable    # (rest (m,3), params (p,), rng) → local shape to perturb
+
+
+SPECS = {
+    "rigid_panel": Spec(_same, _same, _same, _rest_shape),
+    "bending_hinge": Spec(_hinge_rest, _hinge_live, _hinge_random, _hinge_bent),
+}
+
+
+def spec(name) -> Spec:
+    if name not in SPECS or name not in naive.NAIVE:
+        pytest.fail(f"element type {name!r} has no contract spec in tests/test_elements.py "
+                    "(SPECS) or no NumPy twin in tests/naive.py (NAIVE): add both")
+    return SPECS[name]
+
+
+def groups_of(name) -> list:
+    found = [(s, m, m.groups[name]) for s, m in scenes().items() if name in m.groups]
+    if not found:
+        pytest.fail(f"no test scene builds a group of element type {name!r}")
+    return found
+
+
+# ---------------------------------------------------------------- helpers
+def random_rotation(rng) -> np.ndarray:
+    q, r = np.linalg.qr(rng.normal(size=(3, 3)))
+    q = q * np.sign(np.diag(r))
+    return q if np.linalg.det(q) > 0 else -q
+
+
+def run(name, x, g, params):
+    """Call the registered batch loop; returns (out, energy, state)."""
+    etype = elements.get(name)
+    n = len(g.indptr) - 1
+    out = np.zeros((len(g.indices), 3))
+    energy = np.zeros(n)
+    state = np.zeros((n, len(etype.state)))
+    etype.batch(np.ascontiguousarray(x, dtype=np.float64), g.indptr, g.indices, g.rest,
+                np.ascontiguousarray(params, dtype=np.float64), out, energy, state)
+    return out, energy, state
+
+
+def sizes(g):
+    """Per-element diameter of the rest shape (mm), and the same per slot."""
+    ptr = g.indptr
+    d = np.array([2 * np.linalg.norm(g.rest[ptr[e]:ptr[e + 1]], axis=1).max()
+                  for e in range(len(ptr) - 1)])
+    return d, np.repeat(d, np.diff(ptr))[:, None]
+
+
+def centroids(x, g):
+    return np.array([x[g.indices[g.indptr[e]:g.indptr[e + 1]]].mean(axis=0)
+                     for e in range(len(g.indptr) - 1)])
+
+
+def soup(name, groups, rng, min_elements=300):
+    """Independent copies of the groups' elements: random shapes, poses, params."""
+    sp = spec(name)
+    rest, params, counts = [], [], []
+    while len(counts) < min_elements:
+        for g in groups:
+            for e in range(len(g)):
+                rest.append(g.rest[g.slots(e)])
+                counts.append(len(rest[-1]))
+                params.append(sp.random_params(g.params[e:e + 1], rng)[0])
+    indptr = np.zeros(len(counts) + 1, dtype=np.int64)
+    np.cumsum(counts, out=indptr[1:])
+    x = []
+    for r, p in zip(rest, params):
+        scale = 2 * np.linalg.norm(r, axis=1).max()
+        local = sp.random_shape(r, p, rng) + rng.normal(0, 0.02 * scale, r.shape)
+        x.append(local @ random_rotation(rng).T + rng.uniform(-100, 100, 3))
+    g = SimpleNamespace(indptr=indptr, indices=np.arange(indptr[-1], dtype=np.int64),
+                        rest=np.ascontiguousarray(np.vstack(rest)))
+    return np.vstack(x), g, np.array(params).reshape(len(counts), -1)
+
+
+def states(name, kind, seed=0):
+    """[(label, x, group_like, params)] of one type, for one kind of state."""
+    rng = np.random.default_rng(seed)
+    found = groups_of(name)
+    if kind == "soup":
+        x, g, p = soup(name, [g for _, _, g in found], rng)
+        return [("soup", x, g, p)]
+    out = []
+    for label, mesh, g in found:
+        x = mesh.rest_positions + rng.normal(0, 0.05 * mesh.thickness, (mesh.n_vertices, 3))
+        out.append((label, x, g, spec(name).live_params(g.params)))
+    return out
+
+
+def assert_energy_close(e1, e0, m, size, factor=1.0):
+    tol = factor * (RTOL * size * np.sqrt(m * np.maximum(e0, 0)) + 1e-24 * m * size ** 2)
+    assert np.all(np.abs(e1 - e0) <= tol), np.max(np.abs(e1 - e0) / tol)
+
+
+# -------------------------------------------------------------- contracts
+@pytest.mark.parametrize("name", TYPES)
+def test_rest_shape_is_a_fixed_point(name):
+    for label, mesh, g in groups_of(name):
+        x = mesh.rest_positions
+        out, energy, _ = run(name, x, g, spec(name).rest_params(g.params))
+        size, slot_size = sizes(g)
+        centred = x[g.indices] - np.repeat(centroids(x, g), np.diff(g.indptr), axis=0)
+        assert np.all(np.abs(out - centred) <= RTOL * slot_size), label
+        assert np.all(energy <= 1e-24 * np.diff(g.indptr) * size ** 2), label
+
+
+@pytest.mark.parametrize("kind", KINDS)
+@pytest.mark.parametrize("name", TYPES)
+def test_rigid_motion_invariance(name, kind):
+    rng = np.random.default_rng(1)
+    for label, x, g, params in states(name, kind):
+        q, b = random_rotation(rng), rng.uniform(-50, 50, 3)
+        out, energy, state = run(name, x, g, params)
+        out2, energy2, state2 = run(name, x @ q.T + b, g, params)
+        size, slot_size = sizes(g)
+        assert np.all(np.abs(out2 - out @ q.T) <= RTOL * slot_size), label
+        assert np.all(np.abs(energy2 - energy) <= 1e-10 * energy + 1e-24 * size ** 2), label
+        np.testing.assert_allclose(state2, state, rtol=0, atol=1e-10, err_msg=label)
+
+
+@pytest.mark.parametrize("kind", KINDS)
+@pytest.mark.parametrize("name", TYPES)
+def test_projection_is_idempotent(name, kind):
+    for label, x, g, params in states(name, kind):
+        out, _, state = run(name, x, g, params)
+        counts = np.diff(g.indptr)
+        x2 = np.repeat(centroids(x, g), counts, axis=0) + out
+        soup_g = SimpleNamespace(indptr=g.indptr, indices=np.arange(len(x2), dtype=np.int64),
+                                 rest=g.rest)
+        out2, energy2, state2 = run(name, x2, soup_g, params)
+        size, slot_size = sizes(g)
+        assert np.all(np.abs(out2 - out) <= RTOL * slot_size), label
+        assert np.all(energy2 <= 1e-22 * counts * size ** 2), label
+        np.testing.assert_allclose(state2, state, rtol=0, atol=1e-10, err_msg=label)
+
+
+@pytest.mark.parametrize("kind", KINDS)
+@pytest.mark.parametrize("name", TYPES)
+def test_kernel_equals_numpy_twin(name, kind):
+    spec(name)
+    for seed in range(3):
+        for label, x, g, params in states(name, kind, seed):
+            out, energy, state = run(name, x, g, params)
+            out_n, energy_n, state_n = naive.project_group(name, x, g, params)
+            size, slot_size = sizes(g)
+            assert np.all(np.abs(out - out_n) <= RTOL * slot_size), label
+            assert_energy_close(energy, energy_n, np.diff(g.indptr), size)
+            np.testing.assert_allclose(state, state_n, rtol=0, atol=1e-12, err_msg=label)
+
+
+def test_twin_states_cover_the_clamps():
+    """The soup really holds wrong-side M/V estimates and angles beyond max_angle."""
+    x, g, p = soup("bending_hinge", [g for _, _, g in groups_of("bending_hinge")],
+                   np.random.default_rng(0))
+    passive = np.isnan(p[:, TARGET])
+    est = np.array([naive.estimate_angle(x[g.indices[g.indptr[e]:g.indptr[e + 1]]],
+                                         p[e, EXACT] > 0.5) for e in range(len(p))])
+    wrong_side = passive & (p[:, SIGN] * est < 0)
+    too_far = passive & (np.abs(est) > p[:, MAX_ANGLE])
+    assert len(p) >= 300 and wrong_side.sum() >= 20 and too_far.sum() >= 20
+
+
+# ----------------------------------------------------------------- threads
+@pytest.fixture
+def thread_counts():
+    if numba.config.NUMBA_NUM_THREADS < 2:
+        pytest.skip("numba has fewer than 2 threads")
+    before = numba.get_num_threads()
+    yield (1, 2)
+    numba.set_num_threads(before)
+
+
+def _with_threads(n, fn, *args):
+    numba.set_num_threads(n)
+    return fn(*args)
+
+
+@pytest.mark.parametrize("kind", KINDS)
+@pytest.mark.parametrize("name", TYPES)
+def test_batch_identical_with_1_and_2_threads(name, kind, thread_counts):
+    for label, x, g, params in states(name, kind):
+        one, two = (_with_threads(n, run, name, x, g, params) for n in thread_counts)
+        _, slot_size = sizes(g)
+        assert np.all(np.abs(one[0] - two[0]) <= RTOL * slot_size), label
+        np.testing.assert_allclose(one[1], two[1], rtol=RTOL, atol=0, err_msg=label)
+        np.testing.assert_allclose(one[2], two[2], rtol=0, atol=RTOL, err_msg=label)
+
+
+@pytest.mark.parametrize("scene", list(scenes()))
+def test_gather_identical_with_1_and_2_threads(scene, thread_counts):
+    mesh = scenes()[scene]
+    rng = np.random.default_rng(2)
+    groups = list(mesh.groups.values())
+    indices = np.concatenate([g.indices for g in groups])
+    v_indptr, v_slots = vertex_slots(indices, mesh.n_vertices)
+    weights = rng.uniform(0.5, 2.0, len(indices))
+    targets = rng.normal(size=(len(indices), 3))
+    rhs = [np.zeros((mesh.n_vertices, 3)) for _ in thread_counts]
+    for n, r in zip(thread_counts, rhs):
+        _with_threads(n, gather, v_indptr, v_slots, weights, targets, r)
+    np.testing.assert_allclose(rhs[0], rhs[1], rtol=RTOL, atol=0)
+    expected = np.zeros((mesh.n_vertices, 3))
+    np.add.at(expected, indices, weights[:, None] * targets)
+    np.testing.assert_allclose(rhs[0], expected, rtol=1e-12, atol=1e-12)
+
+
+# ----------------------------------------------------------- hinge physics
+def _strip(width=1.0, height=0.8, length=5.0):
+    """Rest (8, 3) of one sub-strip in its local frame, kernel vertex order."""
+    x, y, z = width / 2, height / 2, length / 2
+    top = [(-x, y, -z), (x, y, -z), (x, y, z), (-x, y, z)]
+    return np.array(top + [(a, -y, c) for a, _, c in top])
+
+
+def _project_strip(rest, phi, exact, x=None, passive=False):
+    params = np.array([[1.0, 0.8, np.nan if passive else phi, 0.0, math.pi, 0.0,
+                        float(exact)]])
+    g = SimpleNamespace(indptr=np.array([0, 8], dtype=np.int64),
+                        indices=np.arange(8, dtype=np.int64), rest=rest)
+    return run("bending_hinge", rest if x is None else x, g, params)
+
+
+def _d(p, i, j):
+    return np.linalg.norm(p[i] - p[j])
+
+
+@pytest.mark.parametrize("phi", [-2.0, -0.7, 0.3, 1.0, 2.5])
+def test_exact_arc_target_is_a_circular_bend(phi):
+    rest = _strip()
+    width, height = 1.0, 0.8
+    out, _, state = _project_strip(rest, phi, exact=True)
+    radius = width / phi
+    assert state[0, 0] == phi
+    for i, j in ((0, 1), (3, 2)):
+        assert _d(out, i, j) == pytest.approx(2 * (radius - height / 2) * math.sin(phi / 2),
+                                              rel=1e-12)
+    for i, j in ((4, 5), (7, 6)):
+        assert _d(out, i, j) == pytest.approx(2 * (radius + height / 2) * math.sin(phi / 2),
+                                              rel=1e-12)
+    for top in range(4):  # end faces have length H and point at the arc's centre
+        assert _d(out, top, top + 4) == pytest.approx(height, rel=1e-12)
+    centres = [out[t] + (out[t] - out[t + 4]) / height * (radius - height / 2)
+               for t in range(4)]
+    assert np.allclose(centres[0], centres[1], rtol=0, atol=1e-12 * abs(radius))
+    assert np.allclose(centres[3], centres[2], rtol=0, atol=1e-12 * abs(radius))
+    # its own estimate (asin) returns φ, so a passive arc strip is a fixed point
+    assert naive.estimate_angle(out, True) == pytest.approx(phi, abs=1e-12)
+    assert _project_strip(rest, 0.0, True, x=out, passive=True)[2][0, 0] == pytest.approx(
+        phi, abs=1e-12)
+
+
+@pytest.mark.parametrize("phi", [-1.7, -0.7, 0.3, 1.0, 1.5])
+def test_eq8_target_is_inverted_by_eq9(phi):
+    """Within one strip's limit 2·atan(W/H) (1.79 rad here) the top face stays positive."""
+    rest = _strip()
+    height = 0.8
+    out, _, _ = _project_strip(rest, phi, exact=False)
+    w_top, w_bot, _ = naive.strip_measures(out)
+    assert w_bot - w_top == pytest.approx(2 * height * math.tan(phi / 2), abs=1e-12)
+    assert naive.estimate_angle(out, False) == pytest.approx(phi, abs=1e-12)
+    kernel_phi = _project_strip(rest, 0.0, False, x=out, passive=True)[2][0, 0]
+    assert kernel_phi == pytest.approx(phi, abs=1e-12)
+
+
+def test_bend_is_continuous_at_zero():
+    rest = _strip()
+    for exact in (False, True):
+        out, energy, _ = _project_strip(rest, 1e-13, exact)
+        assert np.allclose(out, rest, rtol=0, atol=1e-12) and energy[0] < 1e-24
+
+
+# ---------------------------------------------------------------- registry
+@pytest.mark.parametrize("name", TYPES)
+def test_registered_type_has_metadata(name):
+    etype = elements.get(name)
+    assert etype.name == name and name in elements.registered()
+    assert isinstance(etype.params, tuple) and all(isinstance(p, str) for p in etype.params)
+    assert isinstance(etype.state, tuple) and callable(etype.batch)
+
+
+def test_unknown_type_lists_available():
+    with pytest.raises(KeyError, match="available: .*rigid_panel"):
+        elements.get("nope")
+
+
+@pytest.fixture
+def saved_registry():
+    elements.get("rigid_panel")
+    saved = dict(_registry._REGISTRY)
+    yield
+    _registry._REGISTRY.clear()
+    _registry._REGISTRY.update(saved)
+
+
+def test_name_collision_warns(saved_registry):
+    original = elements.get("rigid_panel")
+    with pytest.warns(RuntimeWarning, match="rigid_panel"):
+        class Impostor(elements.ElementType):
+            name = "rigid_panel"
+    assert elements.get("rigid_panel") is Impostor
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+
+        class Fresh(elements.ElementType):
+            name = "test_fresh_type"
+    assert elements.get("test_fresh_type") is Fresh and original is not Impostor
+
+
+def test_registry_left_untouched():
+    assert elements.get("rigid_panel").__module__ == "elements.rigid_panel"
+    assert "test_fresh_type" not in elements.registered()
