@@ -1,0 +1,43 @@
+"""Measurements on a deformed thick mesh: panel rotations and fold angles.
+
+Fold angle of a crease = signed dihedral between the mid-planes of its two
+panels, valley positive (FOLD), measured from panel geometry, not from hinges.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+
+def element_rotations(group, positions: np.ndarray) -> np.ndarray:
+    """(n, 3, 3) best-fit rotation of each element's rest shape onto its current shape."""
+    covs = np.zeros((len(group), 3, 3))
+    for e in range(len(group)):
+        s = group.slots(e)
+        p = positions[group.indices[s]]
+        covs[e] = (p - p.mean(axis=0)).T @ group.rest[s]
+    u, _, vt = np.linalg.svd(covs)
+    flip = np.linalg.det(u) * np.linalg.det(vt) < 0
+    u[flip, :, 2] *= -1
+    return u @ vt
+
+
+def fold_angles(pattern, mesh, positions: np.ndarray) -> np.ndarray:
+    """(E,) fold angle of every edge in degrees, valley positive; NaN for ``B`` edges.
+
+    Uses the panels' best-fit rotations R_L, R_R of the faces left and right of
+    each crease a→b: with normals n = R·ẑ and crease direction d = R·(b − a)
+    averaged over both panels, ρ = atan2((n_R × n_L)·d, n_L·n_R).
+    """
+    panels = mesh.groups[mesh.panel_group]
+    rot = element_rotations(panels, positions)
+    out = np.full(pattern.n_edges, np.nan)
+    crease = pattern.creases
+    left = rot[mesh.panel_of_face[pattern.edge_faces[crease, 0]]]
+    right = rot[mesh.panel_of_face[pattern.edge_faces[crease, 1]]]
+    d2 = pattern.vertices[pattern.edges[crease, 1]] - pattern.vertices[pattern.edges[crease, 0]]
+    d_rest = np.column_stack([d2, np.zeros(len(crease))])
+    d = np.einsum("nij,nj->ni", left + right, d_rest)
+    n_left, n_right = left[:, :, 2], right[:, :, 2]
+    sin = np.einsum("ni,ni->n", np.cross(n_right, n_left), d / np.linalg.norm(d, axis=1)[:, None])
+    out[crease] = np.degrees(np.arctan2(sin, np.einsum("ni,ni->n", n_left, n_right)))
+    return out

@@ -1,0 +1,63 @@
+"""Outputs of a run: the JSON report and the folded thick solid as a FOLD frame.
+
+Reads a Result (and the mesh/pattern it came from); never drives the solver.
+"""
+from __future__ import annotations
+
+import json
+import platform
+
+import numpy as np
+
+from .mesh import surface_faces
+
+
+def folded_frame(mesh, positions: np.ndarray) -> dict:
+    """FOLD frame of the folded thick solid: 3D coordinates (mm) and surface faces."""
+    return {"frame_classes": ["foldedForm"], "frame_attributes": ["3D"],
+            "frame_unit": "mm", "frame_parent": 0, "frame_inherit": False,
+            "vertices_coords": np.asarray(positions).tolist(),
+            "faces_vertices": [f.tolist() for f in surface_faces(mesh)]}
+
+
+def _nullable(values) -> list:
+    return [float(v) if np.isfinite(v) else None for v in np.asarray(values, dtype=float)]
+
+
+def report_dict(result, pattern, mesh, settings: dict) -> dict:
+    """The JSON report of a run (contract in DESIGN.md), plus the settings used.
+
+    Angles in degrees (valley > 0), lengths mm, times seconds.
+    """
+    import numba
+
+    from .linsolve import cholmod_available
+
+    energy = result.energy
+    return {
+        "iterations": int(result.iterations),
+        "converged": bool(result.converged),
+        "energy": float(energy[-1]) if len(energy) else 0.0,
+        "energy_history": energy.tolist(),
+        "fold_angles_deg": _nullable(result.fold_angles_deg),
+        "target_angles_deg": _nullable(pattern.fold_angles),
+        "strip_angles_deg": result.strip_angles_deg.tolist(),
+        "vertices": int(mesh.n_vertices),
+        "elements": {name: len(g) for name, g in mesh.groups.items()},
+        "hinge_width_mm": _nullable(mesh.hinge_width),
+        "subdivisions": mesh.subdivisions.tolist(),
+        "timings_s": {k: float(v) for k, v in result.timings_s.items()},
+        "settings": settings,
+        "machine": {"python": platform.python_version(), "numba": numba.__version__,
+                    "numba_threads": numba.get_num_threads(),
+                    "cholmod": cholmod_available()},
+    }
+
+
+def write_report(path, report: dict) -> None:
+    """Write the report as indented JSON, atomically."""
+    from .io.fold import atomic_write
+
+    with atomic_write(path) as fh:
+        json.dump(report, fh, indent=1, allow_nan=False)
+        fh.write("\n")

@@ -1,0 +1,64 @@
+"""Offscreen PNG renders of a folded thick mesh (pyvista, imported only here).
+
+Panels are drawn light grey; hinge sub-strips are coloured by their crease's
+assignment: valley blue, mountain red, other creases amber.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+HINGE_COLOURS = {"V": (0.20, 0.40, 0.85), "M": (0.85, 0.25, 0.20),
+                 "U": (0.95, 0.65, 0.10), "F": (0.60, 0.60, 0.60)}
+PANEL_COLOUR = (0.88, 0.88, 0.86)
+
+
+def _element_surface(mesh, group, positions):
+    import pyvista as pv
+
+    faces = []
+    for i in range(len(group)):
+        ids = group.indices[group.slots(i)]
+        n = len(ids) // 2
+        top, bot = ids[:n], ids[n:]
+        faces += [np.r_[n, top], np.r_[n, bot[::-1]]]
+        faces += [np.r_[4, top[(j + 1) % n], top[j], bot[j], bot[(j + 1) % n]] for j in range(n)]
+    return pv.PolyData(np.asarray(positions), np.concatenate(faces))
+
+
+def render_png(pattern, mesh, positions, path, size=(1024, 768), view="iso") -> None:
+    """Render the thick mesh at ``positions`` (N, 3) mm to a PNG file, offscreen.
+
+    Parameters
+    ----------
+    view : {"iso", "top", "side"}
+        Camera preset.
+    """
+    import pyvista as pv
+
+    plotter = pv.Plotter(off_screen=True, window_size=list(size))
+    plotter.set_background("white")
+    panels = mesh.groups[mesh.panel_group]
+    plotter.add_mesh(_element_surface(mesh, panels, positions), color=PANEL_COLOUR,
+                     show_edges=True, edge_color=(0.35, 0.35, 0.35), line_width=1)
+    hinges = mesh.groups.get("bending_hinge")
+    if hinges is not None and len(hinges):
+        kinds = pattern.assignments[hinges.source]
+        for kind, colour in HINGE_COLOURS.items():
+            chosen = np.flatnonzero(kinds == kind)
+            if len(chosen):
+                sub = _subset(hinges, chosen)
+                plotter.add_mesh(_element_surface(mesh, sub, positions), color=colour,
+                                 show_edges=True, edge_color=(0.2, 0.2, 0.2), line_width=1)
+    getattr(plotter, {"iso": "view_isometric", "top": "view_xy", "side": "view_xz"}[view])()
+    plotter.screenshot(str(path))
+    plotter.close()
+
+
+def _subset(group, chosen):
+    from .mesh import ElementGroup
+
+    sizes = np.diff(group.indptr)[chosen]
+    indptr = np.r_[0, np.cumsum(sizes)]
+    indices = np.concatenate([group.indices[group.slots(i)] for i in chosen])
+    return ElementGroup(group.kind, indptr, indices, group.rest, group.params[chosen],
+                        group.volumes[chosen], group.weights[chosen], group.source[chosen])

@@ -1,0 +1,315 @@
+"""Simulation: actuation, the local/global iteration and its result (paper §3–4).
+
+Units at this API: mm for lengths and positions, degrees for angles.
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+import elements
+from elements.bending_hinge import FLOOR, TARGET
+from .errors import SimulationError
+from .measure import fold_angles
+from .system import System
+
+SOLVERS = ("paper",)
+ALPHA_UPDATE_EVERY = 10  # iterations between α-schedule updates (each costs a refactor)
+
+
+@dataclass
+class PositionTarget:
+    """Vertices pulled toward target positions with weight α (paper Eq. 5–6).
+
+    ``alpha`` is dimensionless: α = 1 pins a vertex as stiffly as the mean
+    element connection of a vertex. ``decay`` < 1 multiplies α every
+    ``ALPHA_UPDATE_EVERY`` iterations (§3.2: α goes from 1 toward 0 as the
+    optimisation converges); below ``1e-6`` the target is dropped.
+    """
+
+    vertices: np.ndarray
+    positions: np.ndarray
+    alpha: float = 1.0
+    decay: float = 1.0
+
+
+@dataclass
+class Result:
+    """What a run produced. Angles in degrees (valley > 0), positions in mm.
+
+    Attributes
+    ----------
+    positions : (N, 3) float
+    fold_angles_deg : (E,) float, NaN for boundary edges
+    strip_angles_deg : (S,) float, bend angle used by each hinge sub-strip
+    energy : (iterations,) float, energy before each global step, mm⁵
+    iterations : int
+    converged : bool
+    timings_s : dict with ``setup``, ``projection``, ``solve``, ``total`` (seconds)
+    """
+
+    positions: np.ndarray
+    fold_angles_deg: np.ndarray
+    strip_angles_deg: np.ndarray
+    energy: np.ndarray
+    iterations: int
+    converged: bool
+    timings_s: dict = field(default_factory=dict)
+
+
+class _GroupRun:
+    """Run-time arrays of one element group: parameters, outputs, state."""
+
+    def __init__(self, group, offset: int):
+        self.group = group
+        self.etype = elements.get(group.kind)
+        self.params = np.array(group.params, dtype=np.float64, order="C")
+        self.energy = np.zeros(len(group))
+        self.state = np.zeros((len(group), len(self.etype.state)))
+        self.slots = slice(offset, offset + len(group.indices))
+
+    def project(self, x, targets):
+        g = self.group
+        self.etype.batch(x, g.indptr, g.indices, g.rest, self.params, targets[self.slots],
+                         self.energy, self.state)
+        return float(self.energy @ g.weights)
+
+
+class Simulation:
+    """Fold a thick mesh by alternating projections and global solves.
+
+    Parameters
+    ----------
+    mesh : ThickMesh
+    pattern : CreasePattern
+        The pattern the mesh was made from (targets, assignments, measurement).
+    solver : str
+        Iteration strategy; ``"paper"`` is the paper's plain local/global map.
+    backend : str
+        Linear-solver backend: ``"auto"``, ``"cholmod"`` or ``"scipy"``.
+    passive_floor_deg : float
+        Fold magnitude (degrees per crease) a passive M/V hinge is given when
+        its estimate has the wrong sign (§4.2 "a small value"); default 0.
+    threads : int, optional
+        numba threads for the projection loop (default: numba's setting).
+    """
+
+    def __init__(self, mesh, pattern, solver: str = "paper", backend: str = "auto",
+                 passive_floor_deg: float = 0.0, threads: int | None = None):
+        start = time.perf_counter()
+        if solver not in SOLVERS:
+            raise SimulationError(f"unknown solver {solver!r} (available: {', '.join(SOLVERS)})")
+        if threads is not None:
+            import numba
+            numba.set_num_threads(int(threads))
+        self.mesh, self.pattern, self.solver = mesh, pattern, solver
+        self.x = mesh.rest_positions.copy()
+        self._runs, offset = [], 0
+        for g in mesh.groups.values():
+            if len(g):
+                self._runs.append(_GroupRun(g, offset))
+                offset += len(g.indices)
+        self._targets = np.zeros((offset, 3))
+        self._rhs = np.zeros((mesh.n_vertices, 3))
+        self.system = System([r.group for r in self._runs], mesh.n_vertices, backend)
+        self._hinges = next((r for r in self._runs if r.group.kind == "bending_hinge"), None)
+        self._fold_targets = np.array(pattern.fold_angles, dtype=float)
+        self._fold_targets[pattern.assignments == "F"] = 0.0
+        self._percent = 100.0
+        self._set_floor(passive_floor_deg)
+        self._apply_fold_targets()
+        self._position_targets: dict[str, PositionTarget] = {}
+        self._update_pins()
+        self.iterations = 0
+        self.energy_history: list[float] = []
+        self.timings = {"setup": time.perf_counter() - start, "projection": 0.0, "solve": 0.0}
+        self.length_scale = float(np.ptp(pattern.vertices, axis=0).max())
+
+    # ------------------------------------------------------------- actuation
+    def set_fold_angles(self, angles) -> None:
+        """Set target fold angles (degrees, valley > 0) of creases.
+
+        Parameters
+        ----------
+        angles : dict {edge id: angle or None} or (E,) array (NaN = passive)
+            ``None``/NaN makes a crease passive. Boundary edges cannot be set.
+        """
+        items = angles.items() if isinstance(angles, dict) else enumerate(np.asarray(angles))
+        new = self._fold_targets.copy()
+        for e, angle in items:
+            new[self._checked_crease(int(e))] = self._checked_angle(int(e), angle)
+        self._fold_targets = new
+        self._apply_fold_targets()
+
+    def set_fold_percent(self, percent: float) -> None:
+        """Scale every actuated target by ``percent``/100 (−100…100, as in other tools)."""
+        if not (np.isfinite(percent) and -100.0 <= percent <= 100.0):
+            raise SimulationError(f"fold percent must be in [-100, 100], got {percent!r}")
+        self._percent = float(percent)
+        self._apply_fold_targets()
+
+    def add_position_target(self, vertices, positions=None, alpha: float = 1.0,
+                            decay: float = 1.0, name: str | None = None) -> str:
+        """Pull vertices toward positions (mm); returns the target's name.
+
+        ``positions`` defaults to the vertices' current positions (a pin).
+        """
+        ids = np.atleast_1d(np.asarray(vertices, dtype=np.int64))
+        if ids.size == 0 or ids.min() < 0 or ids.max() >= self.mesh.n_vertices:
+            raise SimulationError(f"position target: vertex ids must be in "
+                                  f"0..{self.mesh.n_vertices - 1}")
+        pos = self.x[ids].copy() if positions is None else np.asarray(positions, float)
+        pos = np.broadcast_to(pos, (len(ids), 3)).copy()
+        if not np.isfinite(pos).all() or not (alpha > 0) or not (0 < decay <= 1):
+            raise SimulationError("position target: positions must be finite, alpha > 0, "
+                                  "0 < decay ≤ 1")
+        name = name or f"target{len(self._position_targets)}"
+        self._position_targets[name] = PositionTarget(ids, pos, float(alpha), float(decay))
+        self._update_pins()
+        return name
+
+    def move_position_target(self, name: str, positions) -> None:
+        """New positions (mm) for an existing target (no refactor needed)."""
+        target = self._position_targets[name]
+        target.positions = np.broadcast_to(np.asarray(positions, float), target.positions.shape).copy()
+
+    def remove_position_target(self, name: str) -> None:
+        """Stop pulling the vertices of a target."""
+        del self._position_targets[name]
+        self._update_pins()
+
+    def nearest_vertex(self, point) -> int:
+        """Id of the mesh vertex closest to a 3D point (mm), current positions."""
+        return int(np.argmin(np.linalg.norm(self.x - np.asarray(point, float), axis=1)))
+
+    # ------------------------------------------------------------- iteration
+    def step(self) -> float:
+        """One local/global iteration; returns the largest vertex displacement (mm)."""
+        t0 = time.perf_counter()
+        energy = sum(run.project(self.x, self._targets) for run in self._runs)
+        t1 = time.perf_counter()
+        rhs = self.system.rhs(self._targets, self._rhs)
+        energy += self._add_pin_terms(rhs)
+        new_x = self.system.factor.solve(rhs)
+        t2 = time.perf_counter()
+        self.timings["projection"] += t1 - t0
+        self.timings["solve"] += t2 - t1
+        moved = float(np.abs(new_x - self.x).max())
+        self.x = np.ascontiguousarray(new_x)
+        self.energy_history.append(energy)
+        self.iterations += 1
+        self._advance_alpha()
+        return moved
+
+    def run(self, tolerance: float = 1e-8, max_iterations: int = 10_000, callback=None) -> Result:
+        """Iterate until the largest step is ≤ ``tolerance`` × pattern size.
+
+        Parameters
+        ----------
+        tolerance : float
+            Relative stopping threshold (dimensionless; the pattern's larger
+            extent in mm is the scale).
+        max_iterations : int
+        callback : callable(sim, moved_mm) -> bool or None, optional
+            Called after each iteration; returning False stops the run.
+        """
+        start = time.perf_counter()
+        converged = False
+        for _ in range(int(max_iterations)):
+            moved = self.step()
+            if not np.isfinite(moved):
+                raise SimulationError("the iteration produced non-finite positions")
+            if callback is not None and callback(self, moved) is False:
+                break
+            if moved <= tolerance * self.length_scale:
+                converged = True
+                break
+        self.timings["total"] = time.perf_counter() - start + self.timings["setup"]
+        return self.result(converged)
+
+    # ------------------------------------------------------------- measuring
+    @property
+    def positions(self) -> np.ndarray:
+        """(N, 3) current vertex positions, mm."""
+        return self.x
+
+    def fold_angles(self) -> np.ndarray:
+        """(E,) fold angles in degrees from the panels' mid-planes (NaN for B)."""
+        return fold_angles(self.pattern, self.mesh, self.x)
+
+    def strip_angles(self) -> np.ndarray:
+        """(S,) bend angle (degrees) each hinge sub-strip used in the last projection."""
+        if self._hinges is None:
+            return np.zeros(0)
+        return np.degrees(self._hinges.state[:, 0])
+
+    def result(self, converged: bool) -> Result:
+        """Snapshot of the current state as a :class:`Result`."""
+        timings = {k: float(v) for k, v in self.timings.items()}
+        timings.setdefault("total", sum(timings.values()))
+        return Result(self.x.copy(), self.fold_angles(), self.strip_angles(),
+                      np.array(self.energy_history), self.iterations, converged, timings)
+
+    # --------------------------------------------------------------- private
+    def _checked_crease(self, e: int) -> int:
+        if not 0 <= e < self.pattern.n_edges:
+            raise SimulationError(f"edge {e} does not exist (0..{self.pattern.n_edges - 1})")
+        if self.pattern.assignments[e] == "B":
+            raise SimulationError(f"edge {e} is a boundary edge and has no hinge")
+        return e
+
+    def _checked_angle(self, e: int, angle) -> float:
+        if angle is None or np.isnan(angle):
+            return np.nan
+        kind, limit = self.pattern.assignments[e], self.pattern.max_angles[e]
+        if kind == "M" and angle > 0 or kind == "V" and angle < 0 or abs(angle) > limit:
+            raise SimulationError(f"edge {e}: target {angle:g}° is not allowed for a "
+                                  f"{kind!r} crease with max angle {limit:g}°")
+        return float(angle)
+
+    def _apply_fold_targets(self) -> None:
+        if self._hinges is None:
+            return
+        src = self._hinges.group.source
+        k = self.mesh.subdivisions[src]
+        target = np.radians(self._fold_targets[src] * self._percent / 100.0) / k
+        self._hinges.params[:, TARGET] = target
+
+    def _set_floor(self, floor_deg: float) -> None:
+        if not (np.isfinite(floor_deg) and floor_deg >= 0):
+            raise SimulationError(f"passive floor must be ≥ 0 degrees, got {floor_deg!r}")
+        if self._hinges is not None:
+            k = self.mesh.subdivisions[self._hinges.group.source]
+            self._hinges.params[:, FLOOR] = np.radians(floor_deg) / k
+
+    def _update_pins(self) -> None:
+        weights = np.zeros(self.mesh.n_vertices)
+        for t in self._position_targets.values():
+            np.add.at(weights, t.vertices, t.alpha * self.system.reference_weight)
+        if not self._position_targets:  # anchor: fixes the free translation exactly
+            weights[0] = self.system.reference_weight
+        self._pin_weights = weights
+        self.system.set_pin_weights(weights)
+
+    def _add_pin_terms(self, rhs: np.ndarray) -> float:
+        if not self._position_targets:
+            rhs[0] += self._pin_weights[0] * self.x[0]
+            return 0.0
+        energy = 0.0
+        for t in self._position_targets.values():
+            w = t.alpha * self.system.reference_weight
+            np.add.at(rhs, t.vertices, w * t.positions)
+            energy += w * float(((self.x[t.vertices] - t.positions) ** 2).sum())
+        return energy
+
+    def _advance_alpha(self) -> None:
+        decaying = [t for t in self._position_targets.values() if t.decay < 1.0]
+        if not decaying or self.iterations % ALPHA_UPDATE_EVERY:
+            return
+        for name, t in list(self._position_targets.items()):
+            t.alpha *= t.decay ** ALPHA_UPDATE_EVERY
+            if t.alpha < 1e-6:
+                del self._position_targets[name]
+        self._update_pins()
