@@ -73,6 +73,31 @@ def clamp_angle(phi, sign, floor, max_angle):
 
 
 @njit(cache=True)
+def limit_excess(x, indptr, indices, params, out):
+    """Signed distance (rad) of each passive strip's Eq. 9 estimate past its max angle.
+
+    ``out[e]`` > 0: the strip is bent beyond ``max_angle`` on its allowed side
+    (valley for V, mountain for M, either for U) by that much; ≤ 0: by how much
+    it is short of it; NaN for actuated strips. Only the max-angle side is a
+    physical stop (the joint closes); the M/V side is left to the projection
+    (§4.2) because strips pass through flat transiently while a pattern folds,
+    and a stiff flat strip there jams the fold (measured). Serial loop: it runs
+    once per iteration, where a parallel launch costs more.
+    """
+    for e in range(len(indptr) - 1):
+        p = params[e]
+        if math.isnan(p[TARGET]):
+            phi = estimate_angle(x, indices[indptr[e]:indptr[e + 1]])
+            if p[SIGN] < 0.0:
+                phi = -phi
+            elif p[SIGN] == 0.0:
+                phi = abs(phi)
+            out[e] = phi - p[MAX_ANGLE]
+        else:
+            out[e] = math.nan
+
+
+@njit(cache=True)
 def bent_shape(rest, width, phi, exact_arc, out):
     """Write the strip bent by ``phi`` (rad) into ``out`` (m, 3), centred, local frame."""
     m = rest.shape[0]

@@ -66,6 +66,8 @@ def build_parser() -> argparse.ArgumentParser:
     sim.add_argument("-o", "--output", help="write the result as FOLD (achieved angles + "
                                             "folded solid in file_frames)")
     sim.add_argument("--report", help="write the JSON report here")
+    sim.add_argument("--render", help="write an offscreen PNG render of the folded solid "
+                                      "(needs the 'render' extra: pyvista)")
     return parser
 
 
@@ -105,6 +107,9 @@ def simulate(args) -> int:
         print(f"foldcore: warning: not converged after {result.iterations} iterations "
               f"(tolerance {args.tolerance:g}); the result is the last iterate",
               file=sys.stderr)
+    if args.render:
+        from .render import render_png
+        render_png(pattern, mesh, result.positions, args.render)
     if args.output:
         write_fold(args.output, pattern, achieved_angles=result.fold_angles_deg,
                    frames=[folded_frame(mesh, result.positions)], thickness=thickness)

@@ -5,6 +5,8 @@ assignment: valley blue, mountain red, other creases amber.
 """
 from __future__ import annotations
 
+import os
+
 import numpy as np
 
 HINGE_COLOURS = {"V": (0.20, 0.40, 0.85), "M": (0.85, 0.25, 0.20),
@@ -33,8 +35,7 @@ def render_png(pattern, mesh, positions, path, size=(1024, 768), view="iso") -> 
     view : {"iso", "top", "side"}
         Camera preset.
     """
-    import pyvista as pv
-
+    pv = _pyvista()
     plotter = pv.Plotter(off_screen=True, window_size=list(size))
     plotter.set_background("white")
     panels = mesh.groups[mesh.panel_group]
@@ -50,8 +51,26 @@ def render_png(pattern, mesh, positions, path, size=(1024, 768), view="iso") -> 
                 plotter.add_mesh(_element_surface(mesh, sub, positions), color=colour,
                                  show_edges=True, edge_color=(0.2, 0.2, 0.2), line_width=1)
     getattr(plotter, {"iso": "view_isometric", "top": "view_xy", "side": "view_xz"}[view])()
-    plotter.screenshot(str(path))
-    plotter.close()
+    folder, name = os.path.split(os.path.abspath(os.fspath(path)))
+    tmp = os.path.join(folder, f".{name}.{os.getpid()}.tmp.png")  # no half-written PNG
+    try:
+        plotter.screenshot(tmp)
+        os.replace(tmp, path)
+    finally:
+        plotter.close()
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+
+
+def _pyvista():
+    """pyvista set up for offscreen rendering; EGL directly when there is no display."""
+    if not os.environ.get("DISPLAY"):
+        # without this VTK first tries X, fails with a warning, then falls back to EGL
+        os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
+    import pyvista as pv
+
+    pv.OFF_SCREEN = True
+    return pv
 
 
 def _subset(group, chosen):

@@ -10,13 +10,15 @@ from dataclasses import dataclass, field
 import numpy as np
 
 import elements
-from elements.bending_hinge import FLOOR, TARGET
+from elements.bending_hinge import FLOOR, TARGET, limit_excess
 from .errors import SimulationError
 from .measure import fold_angles
 from .system import System
 
 SOLVERS = ("paper",)
 ALPHA_UPDATE_EVERY = 10  # iterations between α-schedule updates (each costs a refactor)
+STOP_ENTER = 1e-3  # rad past its bound before a passive strip becomes a stop
+STOP_LEAVE = 1e-3  # rad back inside its interval before a stop is released
 
 
 @dataclass
@@ -70,11 +72,11 @@ class _GroupRun:
         self.state = np.zeros((len(group), len(self.etype.state)))
         self.slots = slice(offset, offset + len(group.indices))
 
-    def project(self, x, targets):
+    def project(self, x, targets, weights):
         g = self.group
         self.etype.batch(x, g.indptr, g.indices, g.rest, self.params, targets[self.slots],
                          self.energy, self.state)
-        return float(self.energy @ g.weights)
+        return float(self.energy @ weights)
 
 
 class Simulation:
@@ -92,12 +94,20 @@ class Simulation:
     passive_floor_deg : float
         Fold magnitude (degrees per crease) a passive M/V hinge is given when
         its estimate has the wrong sign (§4.2 "a small value"); default 0.
+    stop_stiffness : float
+        Weight multiplier (dimensionless, ≥ 1) of a passive sub-strip pushed
+        past its allowed interval (wrong M/V side or beyond its max angle) by
+        more than ``STOP_ENTER``: the joint closes and acts as a stop. The
+        paper's projection alone (``1``) only sets the target at the bound, so
+        a position target on a long lever bends a small hinge far past it.
+        Each change of the set of stops costs one numeric refactor.
     threads : int, optional
         numba threads for the projection loop (default: numba's setting).
     """
 
     def __init__(self, mesh, pattern, solver: str = "paper", backend: str = "auto",
-                 passive_floor_deg: float = 0.0, threads: int | None = None):
+                 passive_floor_deg: float = 0.0, stop_stiffness: float = 1e3,
+                 threads: int | None = None):
         start = time.perf_counter()
         if solver not in SOLVERS:
             raise SimulationError(f"unknown solver {solver!r} (available: {', '.join(SOLVERS)})")
@@ -115,6 +125,7 @@ class Simulation:
         self._rhs = np.zeros((mesh.n_vertices, 3))
         self.system = System([r.group for r in self._runs], mesh.n_vertices, backend)
         self._hinges = next((r for r in self._runs if r.group.kind == "bending_hinge"), None)
+        self._init_stops(stop_stiffness)
         self._fold_targets = np.array(pattern.fold_angles, dtype=float)
         self._fold_targets[pattern.assignments == "F"] = 0.0
         self._percent = 100.0
@@ -139,7 +150,8 @@ class Simulation:
         items = angles.items() if isinstance(angles, dict) else enumerate(np.asarray(angles))
         new = self._fold_targets.copy()
         for e, angle in items:
-            new[self._checked_crease(int(e))] = self._checked_angle(int(e), angle)
+            e = self._checked_crease(int(e))
+            new[e] = self._checked_angle(e, angle)
         self._fold_targets = new
         self._apply_fold_targets()
 
@@ -188,7 +200,9 @@ class Simulation:
     def step(self) -> float:
         """One local/global iteration; returns the largest vertex displacement (mm)."""
         t0 = time.perf_counter()
-        energy = sum(run.project(self.x, self._targets) for run in self._runs)
+        energy = sum(run.project(self.x, self._targets, w)
+                     for run, w in zip(self._runs, self.system.weights))
+        self._update_stops()
         t1 = time.perf_counter()
         rhs = self.system.rhs(self._targets, self._rhs)
         energy += self._add_pin_terms(rhs)
@@ -276,6 +290,34 @@ class Simulation:
         k = self.mesh.subdivisions[src]
         target = np.radians(self._fold_targets[src] * self._percent / 100.0) / k
         self._hinges.params[:, TARGET] = target
+
+    def _init_stops(self, stop_stiffness: float) -> None:
+        if not (np.isfinite(stop_stiffness) and stop_stiffness >= 1.0):
+            raise SimulationError(f"stop_stiffness must be a finite number ≥ 1, "
+                                  f"got {stop_stiffness!r}")
+        self._stop_factor = float(stop_stiffness)
+        self.stops = np.zeros(0, dtype=bool)
+        if self._hinges is not None:
+            self._hinge_index = self._runs.index(self._hinges)
+            self.stops = np.zeros(len(self._hinges.group), dtype=bool)
+            self._excess = np.zeros(len(self._hinges.group))
+
+    def _update_stops(self) -> None:
+        """Stiffen passive strips pushed past their interval; release them once back inside."""
+        if self._stop_factor == 1.0 or self._hinges is None:
+            return
+        g = self._hinges.group
+        limit_excess(self.x, g.indptr, g.indices, self._hinges.params, self._excess)
+        passive = ~np.isnan(self._excess)
+        if not passive.any():
+            return
+        excess = np.where(passive, self._excess, -np.inf)
+        stops = np.where(self.stops, excess > -STOP_LEAVE, excess > STOP_ENTER)
+        if np.array_equal(stops, self.stops):
+            return
+        self.stops = stops
+        self.system.set_weights(self._hinge_index,
+                                np.where(stops, self._stop_factor, 1.0) * g.weights)
 
     def _set_floor(self, floor_deg: float) -> None:
         if not (np.isfinite(floor_deg) and floor_deg >= 0):

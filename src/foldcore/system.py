@@ -15,17 +15,24 @@ from numba import njit, prange
 from .linsolve import Factor
 
 
-def element_matrix(groups, n_vertices: int):
-    """K = Σ_e w_e S_eᵀ C_e S_e over every group, (N, N) CSC (weights in mm³)."""
+def element_matrix(groups, weights, n_vertices: int):
+    """K = Σ_e w_e S_eᵀ C_e S_e over every group, (N, N) CSC.
+
+    Parameters
+    ----------
+    groups : sequence of ElementGroup
+    weights : sequence of (n_g,) float, mm³
+        One weight per element of each group.
+    n_vertices : int
+    """
     diag = np.zeros(n_vertices)
     low_rank = sp.csr_matrix((n_vertices, n_vertices))
-    for g in groups:
+    for g, w in zip(groups, weights):
         sizes = np.diff(g.indptr)
-        slot_w = np.repeat(g.weights, sizes)
-        np.add.at(diag, g.indices, slot_w)
+        np.add.at(diag, g.indices, np.repeat(w, sizes))
         incidence = sp.csr_matrix((np.ones(len(g.indices)), g.indices, g.indptr),
                                   shape=(len(g), n_vertices))
-        low_rank = low_rank + incidence.T @ sp.diags(g.weights / sizes) @ incidence
+        low_rank = low_rank + incidence.T @ sp.diags(w / sizes) @ incidence
     return (sp.diags(diag) - low_rank).tocsc()
 
 
@@ -67,19 +74,36 @@ class System:
     Attributes
     ----------
     reference_weight : float
-        Mean diagonal of K (mm³): the scale that makes pin weights dimensionless.
+        Mean diagonal of K at the rest weights (mm³): the scale that makes pin
+        weights dimensionless.
+    weights : list of (n_g,) float
+        Current element weights of each group, mm³ (start: the groups' own).
     """
 
     def __init__(self, groups, n_vertices: int, backend: str = "auto"):
         self.n_vertices = n_vertices
-        self.matrix = element_matrix(groups, n_vertices)
+        self.groups = list(groups)
+        self.weights = [np.array(g.weights, dtype=float) for g in self.groups]
+        self._assemble()
         self.reference_weight = float(self.matrix.diagonal().mean())
-        indices = np.concatenate([g.indices for g in groups])
-        self.slot_weight = np.concatenate([np.repeat(g.weights, np.diff(g.indptr))
-                                           for g in groups])
+        indices = np.concatenate([g.indices for g in self.groups])
         self.v_indptr, self.v_slots = vertex_slots(indices, n_vertices)
         self._pins = np.zeros(n_vertices)
         self.factor = Factor(self._with_pins(), backend)
+
+    def _assemble(self) -> None:
+        self.matrix = element_matrix(self.groups, self.weights, self.n_vertices)
+        self.slot_weight = np.concatenate([np.repeat(w, np.diff(g.indptr))
+                                           for g, w in zip(self.groups, self.weights)])
+
+    def set_weights(self, group: int, weights: np.ndarray) -> bool:
+        """New element weights (mm³) for group ``group``; numeric refactor if changed."""
+        if np.array_equal(weights, self.weights[group]):
+            return False
+        self.weights[group] = np.array(weights, dtype=float)
+        self._assemble()
+        self.factor.refactor(self._with_pins())
+        return True
 
     def _with_pins(self):
         return (self.matrix + sp.diags(self._pins)).tocsc()
