@@ -126,7 +126,10 @@ def main(argv=None) -> int:
     """Entry point of the ``foldcore`` command; returns the exit code."""
     from .errors import FoldcoreError
 
-    args = build_parser().parse_args(argv)
+    try:
+        args = build_parser().parse_args(argv)
+    except SystemExit as exc:  # usage error (already reported) or --help
+        return exc.code
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("default")

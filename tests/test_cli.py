@@ -1,0 +1,163 @@
+"""``foldcore simulate``: the contract of DESIGN.md (report, FOLD output, exit codes).
+
+Runs in-process through ``foldcore.cli.main`` for speed; one test runs the
+installed console script to check the real exit code and the absence of a
+traceback. Scene: a short-panel single hinge at 90° (converges in ~10⁴
+plain iterations).
+"""
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from foldcore import patterns
+from foldcore.cli import main
+from foldcore.io import write_fold
+
+TARGET = 90.0
+
+
+@pytest.fixture
+def fold_file(tmp_path):
+    pattern = patterns.single_hinge(panel_length=5.0, depth=2.0, angle=TARGET, width=2.0)
+    path = tmp_path / "hinge.fold"
+    write_fold(path, pattern, thickness=1.0)
+    return path
+
+
+def _simulate(path, tmp_path, *extra):
+    out, report = tmp_path / "out.fold", tmp_path / "report.json"
+    code = main(["simulate", str(path), "-o", str(out), "--report", str(report),
+                 "--subdivisions", "4", "--tolerance", "1e-9", "--max-iterations", "60000",
+                 *extra])
+    return code, out, report
+
+
+def test_simulate_writes_report_and_fold_of_the_contract(fold_file, tmp_path):
+    code, out, report = _simulate(fold_file, tmp_path)
+    assert code == 0
+    rep = json.loads(report.read_text())
+    for key in ("iterations", "converged", "energy", "fold_angles_deg", "vertices",
+                "elements", "timings_s"):
+        assert key in rep
+    assert set(rep["timings_s"]) >= {"total", "setup", "projection", "solve"}
+    assert rep["converged"] is True
+    assert abs(rep["fold_angles_deg"][0] - TARGET) < 0.05
+    assert all(a is None for a in rep["fold_angles_deg"][1:])   # boundary edges
+    fold = json.loads(out.read_text())
+    assert abs(fold["edges_foldAngle"][0] - TARGET) < 0.05
+    assert fold["foldcore:thickness"] == 1.0
+    (frame,) = fold["file_frames"]
+    assert frame["frame_classes"] == ["foldedForm"]
+    coords = np.array(frame["vertices_coords"])
+    assert coords.shape == (rep["vertices"], 3)
+    faces = frame["faces_vertices"]
+    assert max(max(f) for f in faces) < len(coords)
+
+
+def test_not_converging_is_a_result_with_a_warning(fold_file, tmp_path, capsys):
+    out, report = tmp_path / "out.fold", tmp_path / "r.json"
+    code = main(["simulate", str(fold_file), "--max-iterations", "5", "-o", str(out),
+                 "--report", str(report)])
+    assert code == 0
+    assert json.loads(report.read_text())["converged"] is False
+    assert "not converged" in capsys.readouterr().err
+    assert out.exists()
+
+
+def _edit(fold_file, tmp_path, change) -> str:
+    d = json.loads(fold_file.read_text())
+    change(d)
+    bad = tmp_path / "bad.fold"
+    bad.write_text(json.dumps(d))
+    return str(bad)
+
+
+def _set(key, index, value):
+    def change(d):
+        d[key][index] = value
+    return change
+
+
+def _text(tmp_path, text: str) -> str:
+    bad = tmp_path / "bad.fold"
+    bad.write_text(text)
+    return str(bad)
+
+
+MALFORMED = {
+    "not_json": lambda f, t: _text(t, "{not json"),
+    "nan": lambda f, t: _text(t, f.read_text().replace("[0.0, 0.0]", "[NaN, 0.0]", 1)),
+    "overflow": lambda f, t: _text(t, f.read_text().replace("[0.0, 0.0]", "[1e999, 0.0]", 1)),
+    "bad_index": lambda f, t: _edit(f, t, _set("edges_vertices", 2, [2, 99])),
+    "unknown_assignment": lambda f, t: _edit(f, t, _set("edges_assignment", 0, "X")),
+    "crossing": lambda f, t: _edit(f, t, lambda d: (
+        d["vertices_coords"].append([-2.0, 1.0]), d["vertices_coords"].append([2.0, 1.0]),
+        d["edges_vertices"].append([6, 7]), d["edges_assignment"].append("V"),
+        d["edges_foldAngle"].append(None), d.pop("faces_vertices", None))),
+    "zero_length": lambda f, t: _edit(f, t, lambda d: (
+        d["vertices_coords"].__setitem__(2, d["vertices_coords"][0]))),
+    "sign_vs_assignment": lambda f, t: _edit(f, t, _set("edges_foldAngle", 0, -90.0)),
+}
+WHAT = {"not_json": "JSON", "nan": "NaN", "overflow": "1e999", "bad_index": "edge 2", "unknown_assignment": "edge 0",
+        "crossing": "edge", "zero_length": "edge", "sign_vs_assignment": "edge 0"}
+
+
+@pytest.mark.parametrize("kind", sorted(MALFORMED))
+def test_malformed_file_exits_2_with_one_line_and_no_output(kind, fold_file, tmp_path,
+                                                              capsys):
+    bad = MALFORMED[kind](fold_file, tmp_path)
+    out, report = tmp_path / "out.fold", tmp_path / "r.json"
+    code = main(["simulate", bad, "-o", str(out), "--report", str(report)])
+    err = capsys.readouterr().err
+    assert code == 2
+    assert err.count("\n") == 1 and err.startswith("foldcore: error: ")
+    assert os.path.basename(bad) in err
+    assert WHAT[kind] in err
+    assert "Traceback" not in err
+    assert not out.exists() and not report.exists()
+    assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")]  # no temp files
+
+
+def test_missing_file_and_missing_thickness_exit_2(tmp_path, capsys):
+    assert main(["simulate", str(tmp_path / "nope.fold")]) == 2
+    assert "nope.fold" in capsys.readouterr().err
+    pattern = patterns.single_hinge(angle=30.0, width=2.0)
+    path = tmp_path / "thin.fold"
+    write_fold(path, pattern)                       # no foldcore:thickness
+    assert main(["simulate", str(path)]) == 2
+    assert "--thickness" in capsys.readouterr().err
+
+
+def test_bad_option_values_exit_2(fold_file, capsys):
+    for args in (["--thickness", "-1"], ["--subdivisions", "0"], ["--solver", "magic"],
+                 ["--fold-percent", "400"]):
+        assert main(["simulate", str(fold_file), *args]) == 2, args
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1, err
+
+
+def test_console_script_exit_code_without_traceback(tmp_path):
+    bad = tmp_path / "bad.fold"
+    bad.write_text("[1, 2")
+    proc = subprocess.run([sys.executable, "-m", "foldcore.cli", "simulate", str(bad)],
+                          capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 2
+    assert "Traceback" not in proc.stderr and "bad.fold" in proc.stderr
+
+
+def test_render_option_writes_a_png(fold_file, tmp_path):
+    pytest.importorskip("pyvista")
+    png = tmp_path / "hinge.png"
+    assert main(["simulate", str(fold_file), "--max-iterations", "200",
+                 "--render", str(png)]) == 0
+    import imageio.v3 as iio
+
+    image = iio.imread(png)
+    assert image.ndim == 3 and image.shape[0] > 100
+    assert (image[..., :3] < 200).any()      # something other than white background

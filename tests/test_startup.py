@@ -1,0 +1,51 @@
+"""Start-up contract: ``import foldcore`` is fast and light; kernels come from numba's cache.
+
+Both run in fresh interpreters (subprocesses): the test process has already
+imported everything.
+"""
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+IMPORT_PROBE = """
+import json, sys, time
+t = time.perf_counter()
+import foldcore
+elapsed = time.perf_counter() - t
+heavy = sorted(m for m in ("pyvista", "vtk", "numba", "scipy", "elements") if m in sys.modules)
+print(json.dumps({"seconds": elapsed, "heavy": heavy}))
+"""
+
+RUN_PROBE = """
+import json
+import numba
+from foldcore import patterns, thicken, Simulation
+import elements.bending_hinge as bh, elements.rigid_panel as rp
+from foldcore import system
+p = patterns.single_hinge(panel_length=5.0, depth=2.0, angle=45.0, width=2.0)
+sim = Simulation(thicken(p, 1.0, subdivisions=2), p)
+sim.run(tolerance=0, max_iterations=3)
+misses = {f.__name__ + "@" + f.__module__: sum(f.stats.cache_misses.values())
+          for f in (bh.batch, bh.limit_excess, rp.batch, system.gather)}
+print(json.dumps(misses))
+"""
+
+
+def _probe(code: str) -> dict:
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          timeout=600, check=True)
+    return json.loads(proc.stdout.strip().splitlines()[-1])
+
+
+def test_import_is_fast_and_imports_no_heavy_module():
+    probe = _probe(IMPORT_PROBE)
+    assert probe["heavy"] == []
+    assert probe["seconds"] < 0.5
+
+
+def test_second_process_loads_kernels_from_the_cache():
+    _probe(RUN_PROBE)                  # compiles (cold) or loads (warm)
+    misses = _probe(RUN_PROBE)         # a new process: nothing may compile
+    assert all(n == 0 for n in misses.values()), misses
