@@ -636,7 +636,7 @@ def test_auto_subdivisions_matches_reference(W, H, theta):
 def test_auto_subdivisions_in_mesh():
     pattern = patterns.degree4_vertex(widths=[16.0, 1.6, 4.0, 2.0]).replace(
         max_angles=[180.0, 180.0, 100.0, 30.0] + [180.0] * 6)
-    mesh = thicken(pattern, 1.0, subdivisions="auto")
+    mesh = thicken(pattern, 1.0, subdivisions="auto", exact_arc=False)
     want = [reference_k(w, 1.0, t) for w, t in zip([16.0, 1.6, 4.0, 2.0],
                                                    [180.0, 180.0, 100.0, 30.0])]
     assert want == [4, 7, 3, 2]
@@ -644,13 +644,21 @@ def test_auto_subdivisions_in_mesh():
     check_mesh(pattern, mesh, 1.0)
 
 
-def test_auto_width_with_auto_subdivisions_hits_the_cap():
+def test_auto_width_with_auto_subdivisions_eq8_hits_the_cap():
     # Eq. 7 with r = 0 gives W = Hθ/2; then θ/k > 2 atan(θ/(2k)) for every k, so the
-    # rule can never be satisfied and k stops at its cap (16).
+    # Eq. 8 rule can never be satisfied and k stops at its cap (16).
     pattern = patterns.single_hinge()
-    mesh = thicken(pattern, 1.0)
+    mesh = thicken(pattern, 1.0, exact_arc=False)
     assert mesh.subdivisions[0] == 16
     check_mesh(pattern, mesh, 1.0)
+
+
+def test_auto_subdivisions_exact_arc_uses_the_smoothness_rule_only():
+    # the arc reaches 2W/H = θmax at W = Hθ/2 for any k: k = ceil(180/45) = 4
+    pattern = patterns.single_hinge()
+    mesh = thicken(pattern, 1.0)
+    assert mesh.subdivisions[0] == 4
+    assert int(auto_subdivisions(0.2, 1.0, 30.0, exact_arc=True)[0]) == 2
 
 
 # ====================================================================== errors

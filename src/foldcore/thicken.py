@@ -30,16 +30,23 @@ def minimum_hinge_width(thickness: float, max_angle_deg, bend_radius: float = 0.
     return (bend_radius + 0.5 * thickness) * np.radians(max_angle_deg)
 
 
-def auto_subdivisions(width, thickness: float, max_angle_deg) -> np.ndarray:
+def auto_subdivisions(width, thickness: float, max_angle_deg,
+                      exact_arc: bool = False) -> np.ndarray:
     """Sub-strips per hinge chosen from its largest fold angle.
 
-    Rule: k = max(2, ceil(θmax / 45°)), then raised (up to 16) while one
-    sub-strip of width W/k cannot reach θmax/k under Eq. 8, whose per-strip
-    limit is 2·atan(W/(k·H)) (top face shrinks to zero length).
+    Rule: k = max(2, ceil(θmax / 45°)) (smoothness, paper §6.1). With Eq. 8
+    targets k is then raised (up to 16) while one sub-strip of width W/k
+    cannot reach θmax/k: its limit is 2·atan(W/(k·H)) (top face shrinks to
+    zero length). Exact-arc targets have no per-strip limit: the hinge reaches
+    2W/H whatever k (the inner face of the arc shrinks to zero there), so only
+    the smoothness rule applies. With Eq. 7's minimum width (r = 0) the Eq. 8
+    rule can never be met (θ/k > 2·atan(θ/2k) for all k) and stops at 16.
     """
     width = np.atleast_1d(np.asarray(width, dtype=float))
     theta = np.radians(np.broadcast_to(max_angle_deg, width.shape))
     k = np.maximum(2, np.ceil(np.degrees(theta) / 45.0 - 1e-9)).astype(np.int64)
+    if exact_arc:
+        return k
     for _ in range(MAX_SUBDIVISIONS):
         short = (theta / k > 2 * np.arctan(width / (k * thickness))) & (k < MAX_SUBDIVISIONS)
         if not short.any():
@@ -61,11 +68,12 @@ def _resolve_widths(pattern, thickness, hinge_width, bend_radius) -> np.ndarray:
     return widths
 
 
-def _resolve_subdivisions(pattern, widths, thickness, subdivisions) -> np.ndarray:
+def _resolve_subdivisions(pattern, widths, thickness, subdivisions, exact_arc) -> np.ndarray:
     crease = pattern.assignments != "B"
     if subdivisions is None or (isinstance(subdivisions, str) and subdivisions == "auto"):
         k = np.zeros(pattern.n_edges, dtype=np.int64)
-        k[crease] = auto_subdivisions(widths[crease], thickness, pattern.max_angles[crease])
+        k[crease] = auto_subdivisions(widths[crease], thickness, pattern.max_angles[crease],
+                                      exact_arc)
         return k
     k = np.broadcast_to(np.asarray(subdivisions), (pattern.n_edges,))
     if not np.issubdtype(k.dtype, np.integer) or (k[crease] < 1).any():
@@ -242,7 +250,7 @@ def thicken(pattern: CreasePattern, thickness: float, hinge_width=None,
         raise MeshError(f"{pattern.source}: thickness must be a positive number of mm, "
                         f"got {thickness}")
     widths = _resolve_widths(pattern, thickness, hinge_width, bend_radius)
-    ks = _resolve_subdivisions(pattern, widths, thickness, subdivisions)
+    ks = _resolve_subdivisions(pattern, widths, thickness, subdivisions, exact_arc)
     table = _PointTable()
     corners, corner_ids = _corner_ids(pattern, widths, table)
     inserts: list[dict] = [dict() for _ in pattern.faces]
