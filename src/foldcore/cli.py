@@ -86,8 +86,7 @@ def _load(args):
 def simulate(args) -> int:
     """Run ``foldcore simulate``; raises FoldcoreError on bad input."""
     from .errors import SimulationError
-    from .io import write_fold
-    from .outputs import folded_frame, report_dict, write_report
+    from .outputs import write_result
     from .simulation import Simulation
     from .thicken import thicken
 
@@ -107,18 +106,12 @@ def simulate(args) -> int:
         print(f"foldcore: warning: not converged after {result.iterations} iterations "
               f"(tolerance {args.tolerance:g}); the result is the last iterate",
               file=sys.stderr)
-    if args.render:
-        from .render import render_png
-        render_png(pattern, mesh, result.positions, args.render)
-    if args.output:
-        write_fold(args.output, pattern, achieved_angles=result.fold_angles_deg,
-                   frames=[folded_frame(mesh, result.positions)], thickness=thickness)
-    if args.report:
-        settings = {k: getattr(args, k) for k in ("pattern", "fold_percent", "solver",
-                                                  "tolerance", "max_iterations", "subdivisions")}
-        settings.update(thickness_mm=thickness, exact_arc=not args.eq8,
-                        backend=sim.system.factor.backend)
-        write_report(args.report, report_dict(result, pattern, mesh, settings))
+    settings = {k: getattr(args, k) for k in ("pattern", "fold_percent", "solver",
+                                              "tolerance", "max_iterations", "subdivisions")}
+    settings.update(thickness_mm=thickness, exact_arc=not args.eq8,
+                    backend=sim.system.factor.backend)
+    write_result(result, pattern, mesh, thickness, settings, fold=args.output,
+                 report=args.report, png=args.render)
     return 0
 
 

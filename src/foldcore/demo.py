@@ -69,9 +69,7 @@ def _miura_folded(n: int = 2, m: int = 2, size: float = 5.0, gamma: float = 60.0
 
 def run_scene(scene: Scene, out: Path) -> dict:
     """Fold one scene and write its outputs; returns its summary (see module doc)."""
-    from .io import write_fold
-    from .outputs import folded_frame, report_dict, write_report
-    from .render import render_png
+    from .outputs import write_result
     from .simulation import Simulation
     from .thicken import thicken
 
@@ -82,13 +80,12 @@ def run_scene(scene: Scene, out: Path) -> dict:
     result = sim.run(tolerance=scene.tolerance, max_iterations=scene.max_iterations)
     wall = time.perf_counter() - start
     base = out / scene.name
-    write_fold(base.with_suffix(".fold"), pattern, achieved_angles=result.fold_angles_deg,
-               frames=[folded_frame(mesh, result.positions)], thickness=scene.thickness)
     settings = {"scene": scene.name, "thickness_mm": scene.thickness,
                 "tolerance": scene.tolerance, "max_iterations": scene.max_iterations,
                 "solver": sim.solver, "backend": sim.system.factor.backend}
-    write_report(base.with_suffix(".json"), report_dict(result, pattern, mesh, settings))
-    render_png(pattern, mesh, result.positions, base.with_suffix(".png"))
+    write_result(result, pattern, mesh, scene.thickness, settings,
+                 fold=base.with_suffix(".fold"), report=base.with_suffix(".json"),
+                 png=base.with_suffix(".png"))
     error = np.abs(result.fold_angles_deg - pattern.fold_angles)
     return {"scene": scene.name, "iterations": result.iterations,
             "converged": result.converged, "max_error_deg": float(np.nanmax(error)),

@@ -61,3 +61,28 @@ def write_report(path, report: dict) -> None:
     with atomic_write(path) as fh:
         json.dump(report, fh, indent=1, allow_nan=False)
         fh.write("\n")
+
+
+def write_result(result, pattern, mesh, thickness: float, settings: dict, *, fold=None,
+                 report=None, png=None) -> None:
+    """Write the outputs asked for: FOLD (achieved angles + folded solid), JSON report, PNG.
+
+    Parameters
+    ----------
+    result : Result
+    pattern, mesh : the CreasePattern and ThickMesh the result came from
+    thickness : float, mm (stored as ``foldcore:thickness`` in the FOLD file)
+    settings : dict, recorded in the report
+    fold, report, png : path or None
+        Each file is written atomically; None skips it (and, for ``png``,
+        the pyvista import).
+    """
+    if png:
+        from .render import render_png
+        render_png(pattern, mesh, result.positions, png)
+    if fold:
+        from .io import write_fold
+        write_fold(fold, pattern, achieved_angles=result.fold_angles_deg,
+                   frames=[folded_frame(mesh, result.positions)], thickness=thickness)
+    if report:
+        write_report(report, report_dict(result, pattern, mesh, settings))

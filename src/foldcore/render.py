@@ -14,11 +14,12 @@ HINGE_COLOURS = {"V": (0.20, 0.40, 0.85), "M": (0.85, 0.25, 0.20),
 PANEL_COLOUR = (0.88, 0.88, 0.86)
 
 
-def _element_surface(mesh, group, positions):
+def _element_surface(group, chosen, positions):
+    """PolyData of the prisms ``chosen`` (element indices) of a group at ``positions``."""
     import pyvista as pv
 
     faces = []
-    for i in range(len(group)):
+    for i in chosen:
         ids = group.indices[group.slots(i)]
         n = len(ids) // 2
         top, bot = ids[:n], ids[n:]
@@ -39,7 +40,8 @@ def render_png(pattern, mesh, positions, path, size=(1024, 768), view="iso") -> 
     plotter = pv.Plotter(off_screen=True, window_size=list(size))
     plotter.set_background("white")
     panels = mesh.groups[mesh.panel_group]
-    plotter.add_mesh(_element_surface(mesh, panels, positions), color=PANEL_COLOUR,
+    plotter.add_mesh(_element_surface(panels, range(len(panels)), positions),
+                     color=PANEL_COLOUR,
                      show_edges=True, edge_color=(0.35, 0.35, 0.35), line_width=1)
     hinges = mesh.groups.get("bending_hinge")
     if hinges is not None and len(hinges):
@@ -47,8 +49,7 @@ def render_png(pattern, mesh, positions, path, size=(1024, 768), view="iso") -> 
         for kind, colour in HINGE_COLOURS.items():
             chosen = np.flatnonzero(kinds == kind)
             if len(chosen):
-                sub = _subset(hinges, chosen)
-                plotter.add_mesh(_element_surface(mesh, sub, positions), color=colour,
+                plotter.add_mesh(_element_surface(hinges, chosen, positions), color=colour,
                                  show_edges=True, edge_color=(0.2, 0.2, 0.2), line_width=1)
     getattr(plotter, {"iso": "view_isometric", "top": "view_xy", "side": "view_xz"}[view])()
     folder, name = os.path.split(os.path.abspath(os.fspath(path)))
@@ -72,12 +73,3 @@ def _pyvista():
     pv.OFF_SCREEN = True
     return pv
 
-
-def _subset(group, chosen):
-    from .mesh import ElementGroup
-
-    sizes = np.diff(group.indptr)[chosen]
-    indptr = np.r_[0, np.cumsum(sizes)]
-    indices = np.concatenate([group.indices[group.slots(i)] for i in chosen])
-    return ElementGroup(group.kind, indptr, indices, group.rest, group.params[chosen],
-                        group.volumes[chosen], group.weights[chosen], group.source[chosen])

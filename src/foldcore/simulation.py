@@ -95,9 +95,10 @@ class Simulation:
         Fold magnitude (degrees per crease) a passive M/V hinge is given when
         its estimate has the wrong sign (§4.2 "a small value"); default 0.
     stop_stiffness : float
-        Weight multiplier (dimensionless, ≥ 1) of a passive sub-strip pushed
-        past its allowed interval (wrong M/V side or beyond its max angle) by
-        more than ``STOP_ENTER``: the joint closes and acts as a stop. The
+        Weight multiplier (dimensionless, ≥ 1) of a passive sub-strip bent
+        past its max angle by more than ``STOP_ENTER``: the joint closes and
+        acts as a stop (the M/V side is left to the projection, see
+        :func:`elements.bending_hinge.limit_excess`). The
         paper's projection alone (``1``) only sets the target at the bound, so
         a position target on a long lever bends a small hinge far past it.
         Each change of the set of stops costs one numeric refactor.
@@ -290,6 +291,7 @@ class Simulation:
         k = self.mesh.subdivisions[src]
         target = np.radians(self._fold_targets[src] * self._percent / 100.0) / k
         self._hinges.params[:, TARGET] = target
+        self._passive = np.isnan(target)
 
     def _init_stops(self, stop_stiffness: float) -> None:
         if not (np.isfinite(stop_stiffness) and stop_stiffness >= 1.0):
@@ -303,15 +305,14 @@ class Simulation:
             self._excess = np.zeros(len(self._hinges.group))
 
     def _update_stops(self) -> None:
-        """Stiffen passive strips pushed past their interval; release them once back inside."""
+        """Stiffen passive strips bent past their max angle; release them once back inside."""
         if self._stop_factor == 1.0 or self._hinges is None:
             return
+        if not self._passive.any() and not self.stops.any():
+            return  # all actuated: no estimate to check (stops only on passive strips)
         g = self._hinges.group
         limit_excess(self.x, g.indptr, g.indices, self._hinges.params, self._excess)
-        passive = ~np.isnan(self._excess)
-        if not passive.any():
-            return
-        excess = np.where(passive, self._excess, -np.inf)
+        excess = np.where(self._passive, self._excess, -np.inf)
         stops = np.where(self.stops, excess > -STOP_LEAVE, excess > STOP_ENTER)
         if np.array_equal(stops, self.stops):
             return
