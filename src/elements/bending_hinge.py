@@ -62,6 +62,13 @@ def estimate_angle(x, ids):
     return 2.0 * math.atan2(d, math.sqrt(max(s * s - d * d, 0.0)))
 
 
+@njit(parallel=True, cache=True)
+def estimate_angles(x, indptr, indices, out):
+    """Eq. 9 estimate (rad, valley > 0) of every strip's bend angle into ``out`` (S,)."""
+    for e in prange(len(indptr) - 1):
+        out[e] = estimate_angle(x, indices[indptr[e]:indptr[e + 1]])
+
+
 @njit(cache=True)
 def clamp_angle(phi, sign, floor, max_angle):
     """Project a passive strip's angle onto its allowed interval (§4.2–4.3)."""
@@ -153,6 +160,39 @@ def batch(x, indptr, indices, rest, params, out, energy, state):
     for e in prange(len(indptr) - 1):
         s, t = indptr[e], indptr[e + 1]
         energy[e] = project(x, indices[s:t], rest[s:t], params[e], out[s:t], state[e])
+
+
+SHAPE_STEP = 1e-6  # rad, central-difference step of ``shapes``' derivative
+
+
+@njit(parallel=True, cache=True)
+def shapes(indptr, rest, params, phi, out, d_out):
+    """Bent shapes T(φ) and their derivatives dT/dφ for every sub-strip (local frame).
+
+    For solvers that treat each strip's bend angle as an unknown (the
+    rigid-body strategy). dT/dφ is a central difference of :func:`bent_shape`
+    with step ``SHAPE_STEP`` (truncation ~1e-12·W, round-off ~1e-10·W: ample
+    for a Jacobian), so it stays consistent with the target whatever the
+    shape rule. Allocates nothing: ``out`` is used as scratch first.
+
+    Parameters
+    ----------
+    indptr : (S+1,) int64, slots of each strip
+    rest : (nnz, 3) centred rest shapes, mm
+    params : (S, 7) see ``HINGE_PARAMS``
+    phi : (S,) bend angle per strip, rad
+    out : (nnz, 3) written: T(φ), mm
+    d_out : (nnz, 3) written: dT/dφ, mm/rad
+    """
+    for e in prange(len(indptr) - 1):
+        s, t = indptr[e], indptr[e + 1]
+        exact = params[e, EXACT] > 0.5
+        bent_shape(rest[s:t], params[e, W], phi[e] + SHAPE_STEP, exact, d_out[s:t])
+        bent_shape(rest[s:t], params[e, W], phi[e] - SHAPE_STEP, exact, out[s:t])
+        for k in range(s, t):
+            for d in range(3):
+                d_out[k, d] = (d_out[k, d] - out[k, d]) / (2.0 * SHAPE_STEP)
+        bent_shape(rest[s:t], params[e, W], phi[e], exact, out[s:t])
 
 
 class BendingHinge(ElementType):

@@ -10,6 +10,8 @@ import argparse
 import sys
 import warnings
 
+from .strategies import SOLVERS
+
 EXIT_BAD_INPUT = 2
 
 
@@ -57,7 +59,10 @@ def build_parser() -> argparse.ArgumentParser:
                      help="sub-strips per hinge, or 'auto' (default)")
     sim.add_argument("--fold-percent", type=float, default=100.0,
                      help="scale all target angles, -100…100 (default 100)")
-    sim.add_argument("--solver", default="paper", help="iteration strategy (default: paper)")
+    sim.add_argument("--solver", default="paper", choices=SOLVERS,
+                     help="iteration strategy: paper (the paper's local/global map) or rigid "
+                          "(panels as rigid bodies, Levenberg-Marquardt; far fewer iterations "
+                          "on long panels, rigid panels only); default: paper")
     sim.add_argument("--tolerance", type=_positive, default=1e-8,
                      help="stop when the largest step is below this × pattern size")
     sim.add_argument("--max-iterations", type=int, default=10_000)
