@@ -231,7 +231,6 @@ class RigidBodySolver:
         self.phi_col = self.rot_col + 3 * s
         self.n_unknowns = self.phi_col + self.n_folds
         self._passive = passive.copy()
-        self._fixed = fixed
         self._map_pattern()
 
     def _map_pattern(self) -> None:
@@ -307,11 +306,12 @@ class RigidBodySolver:
 
     # ------------------------------------------------------------- iteration
     def _read_targets(self) -> None:
-        """Angles of actuated strips from the hinge parameters; set up newly passive ones.
+        """Angles of actuated strips from the hinge parameters; set up newly passive creases.
 
-        A strip that becomes passive starts from its Eq. 9 estimate clamped to
-        its interval; an M/V strip that starts flat gets the pre-bend ``SEED``
-        in its assigned direction (once: afterwards its angle is an unknown).
+        A crease that becomes passive starts from the sum of its strips' Eq. 9
+        estimates, spread evenly (one arc) and clamped to its interval; an M/V
+        crease that starts flatter than the pre-bend ``SEED`` per strip gets
+        it, in its assigned direction (once: afterwards its angle is an unknown).
         """
         params = self.hinges.params
         passive = np.isnan(params[:, TARGET])

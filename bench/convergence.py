@@ -1,0 +1,171 @@
+"""Error vs iterations and vs wall time, per strategy, on the convergence scenes.
+
+Scenes (H, W, k in mm / count; exact-arc targets):
+
+* ``hinge_LpH{5,20,80,320}``: one hinge (H = 1, W = 2, k = 4, crease 10 long)
+  between panels Lp long, target 90°. Error = |ρ − 90°| (a compatible
+  target: the closed form is the target itself).
+* ``vertex_thin_actuated``: degree-4 vertex 135/90/45/90, R = 10, H = 0.01
+  (H/R = 1e-3), W = 0.02, k = 4, all four creases actuated to mode A of
+  kinematics.md at ρ1 = 60°. Error = max over creases vs the closed form,
+  and vs a reference converged with the rigid strategy to a 1e-13 step.
+* ``pehrson_90``: Pehrson's vertex at the paper's dimensions (Ø152.4,
+  H = 3.175, W = 16/4/8/4, k = 4), crease 1 actuated to 90°, the others
+  passive. Error = max over creases vs mode A of the closed form.
+
+The rigid strategy stops at a step ≤ 1e-10 × extent; the paper's map runs
+its whole budget (tolerance 0), because its step-size rule stops it early
+on slow scenes (on the thin vertex it "converges" after 40 iterations with
+60° left, measured). Time = the strategy's own time (setup + projection + solve from
+``Simulation.timings``), so measuring the error in the callback does not
+count. The paper's map is run once per scene (20 000 iterations cost ~2 s
+each); the rigid strategy's curve is the median-time run of RUNS runs.
+Writes bench/results/convergence.json and .png.
+"""
+from __future__ import annotations
+
+import json
+import os
+import platform
+import statistics
+from pathlib import Path
+
+import numpy as np
+
+from foldcore import kinematics, patterns, thicken
+from foldcore.simulation import Simulation
+
+RESULTS = Path(__file__).parent / "results"
+RUNS = 3
+BUDGET = {"paper": 20_000, "rigid": 200}
+THRESHOLDS = (1.0, 0.1, 0.01)  # degrees
+
+
+def hinge_scene(ratio: float):
+    pattern = patterns.single_hinge(panel_length=ratio, depth=10.0, angle=90.0, width=2.0)
+    mesh = thicken(pattern, 1.0, subdivisions=4)
+    return pattern, mesh, np.array([90.0]), [0]
+
+
+def thin_vertex_scene():
+    rho = kinematics.degree4_deg(135.0, 90.0, 60.0, "A")
+    pattern = patterns.degree4_vertex(radius=10.0, widths=[0.02] * 4, mode="A", rho1=60.0)
+    pattern = pattern.replace(fold_angles=list(rho) + [None] * (pattern.n_edges - 4))
+    return pattern, thicken(pattern, 0.01, subdivisions=4), rho, [0, 1, 2, 3]
+
+
+def pehrson_scene(rho1: float):
+    pattern = patterns.degree4_vertex(mode="A", rho1=rho1)
+    mesh = thicken(pattern, 3.175, subdivisions=4)
+    return pattern, mesh, kinematics.degree4_deg(135.0, 90.0, rho1, "A"), [0, 1, 2, 3]
+
+
+SCENES = {
+    **{f"hinge_LpH{r}": (lambda r=r: hinge_scene(float(r))) for r in (5, 20, 80, 320)},
+    "vertex_thin_actuated": thin_vertex_scene,
+    "pehrson_90": lambda: pehrson_scene(90.0),
+}
+
+
+def trace(scene, solver: str, budget: int, every: int = 1):
+    """One run: per sampled iteration (iterations, strategy seconds, max error in degrees)."""
+    pattern, mesh, expected, creases = scene
+    sim = Simulation(mesh, pattern, solver=solver)
+    points = []
+
+    def record(s, moved):
+        if s.iterations <= 100 or s.iterations % every == 0:
+            t = s.timings
+            err = float(np.abs(s.fold_angles()[creases] - expected).max())
+            points.append((s.iterations, t["setup"] + t["projection"] + t["solve"], err))
+
+    tolerance = 1e-10 if solver == "rigid" else 0.0
+    result = sim.run(tolerance=tolerance, max_iterations=budget, callback=record)
+    return points, result, sim
+
+
+def first_below(points, threshold):
+    for it, t, err in points:
+        if err <= threshold:
+            return {"iterations": it, "seconds": t}
+    return None
+
+
+def measure_scene(name, make):
+    rows = {}
+    for solver in ("rigid", "paper"):
+        runs = RUNS if solver == "rigid" else 1
+        traces = [trace(make(), solver, BUDGET[solver], every=1 if solver == "rigid" else 20)
+                  for _ in range(runs)]
+        totals = [tr[0][-1][1] for tr in traces]
+        points, result, sim = traces[int(np.argsort(totals)[len(totals) // 2])]
+        its = np.array([p[0] for p in points])
+        secs = np.array([p[1] for p in points])
+        per_it = float(np.median(np.diff(secs[its <= 100]) / np.diff(its[its <= 100]))) \
+            if len(its) > 2 else float("nan")
+        rows[solver] = {
+            "iterations": result.iterations, "converged": result.converged,
+            "final_error_deg": points[-1][2], "seconds": points[-1][1],
+            "seconds_runs": totals, "seconds_per_iteration": per_it,
+            "to_threshold": {f"{t:g}": first_below(points, t) for t in THRESHOLDS},
+            "curve": points}
+        print(f"{name:22s} {solver:6s} its {result.iterations:6d} "
+              f"err {points[-1][2]:.3g}° time {statistics.median(totals):.3f} s", flush=True)
+    return rows
+
+
+def reference(make):
+    """A rigid run converged to a 1e-13 step: the thick model's own answer, beside the closed form."""
+    pattern, mesh, expected, creases = make()
+    sim = Simulation(mesh, pattern, solver="rigid")
+    ref = sim.run(tolerance=1e-13, max_iterations=500)
+    return {"reference_fold_angles_deg": ref.fold_angles_deg[creases].tolist(),
+            "reference_iterations": ref.iterations, "reference_converged": ref.converged,
+            "closed_form_deg": list(map(float, expected))}
+
+
+def plot(data, path: Path) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    names = list(data)
+    fig, axes = plt.subplots(2, len(names), figsize=(3.2 * len(names), 6), squeeze=False)
+    for j, name in enumerate(names):
+        for solver, style in (("paper", "C0-"), ("rigid", "C3.-")):
+            pts = np.array(data[name][solver]["curve"])
+            err = np.maximum(pts[:, 2], 1e-8)
+            axes[0, j].loglog(pts[:, 0], err, style, label=solver, ms=3)
+            axes[1, j].loglog(np.maximum(pts[:, 1], 1e-4), err, style, label=solver, ms=3)
+        axes[0, j].set_title(name, fontsize=9)
+        axes[0, j].set_xlabel("iterations")
+        axes[1, j].set_xlabel("strategy time, s")
+    axes[0, 0].set_ylabel("max fold-angle error, °")
+    axes[1, 0].set_ylabel("max fold-angle error, °")
+    axes[0, 0].legend()
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+
+
+def main() -> None:
+    import numba
+
+    trace(hinge_scene(5.0), "rigid", 5)  # warm-up: numba cache load, first factorisation
+    trace(hinge_scene(5.0), "paper", 5)
+    data = {}
+    for name, make in SCENES.items():
+        data[name] = measure_scene(name, make)
+        if name.startswith("vertex"):
+            data[name]["reference"] = reference(make)
+    RESULTS.mkdir(exist_ok=True)
+    meta = {"machine": platform.processor() or platform.machine(), "cpus": os.cpu_count(),
+            "numba_threads": numba.get_num_threads(), "python": platform.python_version(),
+            "runs_rigid": RUNS, "runs_paper": 1, "tolerance": {"rigid": 1e-10, "paper": 0.0},
+            "budget": BUDGET}
+    (RESULTS / "convergence.json").write_text(json.dumps({"meta": meta, "scenes": data}))
+    plot(data, RESULTS / "convergence.png")
+
+
+if __name__ == "__main__":
+    main()
