@@ -8,6 +8,18 @@ from __future__ import annotations
 import numpy as np
 
 
+def best_rotations(covs: np.ndarray) -> np.ndarray:
+    """(n, 3, 3) rotations R (det = +1) maximising tr(Rᵀ cov) for (n, 3, 3) covariances.
+
+    ``cov`` = Σ p tᵀ over an element's vertices (p current, centred; t target,
+    centred): Kabsch/Procrustes U·diag(1, 1, det(U Vᵀ))·Vᵀ, batched.
+    """
+    u, _, vt = np.linalg.svd(covs)
+    flip = np.linalg.det(u) * np.linalg.det(vt) < 0
+    u[flip, :, 2] *= -1
+    return u @ vt
+
+
 def element_rotations(group, positions: np.ndarray) -> np.ndarray:
     """(n, 3, 3) best-fit rotation of each element's rest shape onto its current shape."""
     covs = np.zeros((len(group), 3, 3))
@@ -15,10 +27,7 @@ def element_rotations(group, positions: np.ndarray) -> np.ndarray:
         s = group.slots(e)
         p = positions[group.indices[s]]
         covs[e] = (p - p.mean(axis=0)).T @ group.rest[s]
-    u, _, vt = np.linalg.svd(covs)
-    flip = np.linalg.det(u) * np.linalg.det(vt) < 0
-    u[flip, :, 2] *= -1
-    return u @ vt
+    return best_rotations(covs)
 
 
 def fold_angles(pattern, mesh, positions: np.ndarray) -> np.ndarray:
