@@ -25,8 +25,6 @@ Writes bench/results/convergence.json and .png.
 from __future__ import annotations
 
 import json
-import os
-import platform
 import statistics
 from pathlib import Path
 
@@ -35,9 +33,13 @@ import numpy as np
 from foldcore import kinematics, patterns, thicken
 from foldcore.simulation import Simulation
 
+from _meta import machine_meta
+
 RESULTS = Path(__file__).parent / "results"
 RUNS = 3
-BUDGET = {"paper": 20_000, "rigid": 200}
+BUDGET = {"paper": 20_000, "anderson": 20_000, "lbfgs": 20_000, "rigid": 200}
+STYLE = {"paper": "C0-", "anderson": "C1-", "lbfgs": "C2-", "rigid": "C3.-"}
+FLOOR_DEG = 1e-9  # a local/global run stops once this close (no curve below it is plotted)
 THRESHOLDS = (1.0, 0.1, 0.01)  # degrees
 
 
@@ -64,6 +66,7 @@ SCENES = {
     **{f"hinge_LpH{r}": (lambda r=r: hinge_scene(float(r))) for r in (5, 20, 80, 320)},
     "vertex_thin_actuated": thin_vertex_scene,
     "pehrson_90": lambda: pehrson_scene(90.0),
+    "pehrson_flat": lambda: pehrson_scene(180.0),
 }
 
 
@@ -78,6 +81,8 @@ def trace(scene, solver: str, budget: int, every: int = 1):
             t = s.timings
             err = float(np.abs(s.fold_angles()[creases] - expected).max())
             points.append((s.iterations, t["setup"] + t["projection"] + t["solve"], err))
+            return err > FLOOR_DEG
+        return None
 
     tolerance = 1e-10 if solver == "rigid" else 0.0
     result = sim.run(tolerance=tolerance, max_iterations=budget, callback=record)
@@ -93,7 +98,7 @@ def first_below(points, threshold):
 
 def measure_scene(name, make):
     rows = {}
-    for solver in ("rigid", "paper"):
+    for solver in ("rigid", "lbfgs", "anderson", "paper"):
         runs = RUNS if solver == "rigid" else 1
         traces = [trace(make(), solver, BUDGET[solver], every=1 if solver == "rigid" else 20)
                   for _ in range(runs)]
@@ -109,7 +114,9 @@ def measure_scene(name, make):
             "seconds_runs": totals, "seconds_per_iteration": per_it,
             "to_threshold": {f"{t:g}": first_below(points, t) for t in THRESHOLDS},
             "curve": points}
-        print(f"{name:22s} {solver:6s} its {result.iterations:6d} "
+        rows[solver]["per_iteration_vs_bare_solve"] = per_it / result.timings_s["bare_solve"]
+        rows[solver]["rejected"] = getattr(sim._accelerated, "rejected", None)
+        print(f"{name:22s} {solver:8s} its {result.iterations:6d} "
               f"err {points[-1][2]:.3g}° time {statistics.median(totals):.3f} s", flush=True)
     return rows
 
@@ -133,7 +140,7 @@ def plot(data, path: Path) -> None:
     names = list(data)
     fig, axes = plt.subplots(2, len(names), figsize=(3.2 * len(names), 6), squeeze=False)
     for j, name in enumerate(names):
-        for solver, style in (("paper", "C0-"), ("rigid", "C3.-")):
+        for solver, style in STYLE.items():
             pts = np.array(data[name][solver]["curve"])
             err = np.maximum(pts[:, 2], 1e-8)
             axes[0, j].loglog(pts[:, 0], err, style, label=solver, ms=3)
@@ -149,19 +156,17 @@ def plot(data, path: Path) -> None:
 
 
 def main() -> None:
-    import numba
-
     trace(hinge_scene(5.0), "rigid", 5)  # warm-up: numba cache load, first factorisation
-    trace(hinge_scene(5.0), "paper", 5)
+    for solver in ("paper", "anderson", "lbfgs"):
+        trace(hinge_scene(5.0), solver, 5)
     data = {}
     for name, make in SCENES.items():
         data[name] = measure_scene(name, make)
         if name.startswith("vertex"):
             data[name]["reference"] = reference(make)
     RESULTS.mkdir(exist_ok=True)
-    meta = {"machine": platform.processor() or platform.machine(), "cpus": os.cpu_count(),
-            "numba_threads": numba.get_num_threads(), "python": platform.python_version(),
-            "runs_rigid": RUNS, "runs_paper": 1, "tolerance": {"rigid": 1e-10, "paper": 0.0},
+    meta = {**machine_meta(), "runs_rigid": RUNS, "runs_local_global": 1,
+            "tolerance": {"rigid": 1e-10, "local_global": 0.0, "stop_below_deg": FLOOR_DEG},
             "budget": BUDGET}
     (RESULTS / "convergence.json").write_text(json.dumps({"meta": meta, "scenes": data}))
     plot(data, RESULTS / "convergence.png")

@@ -9,7 +9,6 @@ Writes bench/results/hinge_targets.json and .png.
 from __future__ import annotations
 
 import json
-import platform
 import statistics
 import time
 from pathlib import Path
@@ -18,6 +17,8 @@ import numpy as np
 
 from foldcore import patterns, thicken
 from foldcore.simulation import Simulation
+
+from _meta import machine_meta
 
 TARGETS = (30.0, 90.0, 150.0, 180.0)
 RUNS = 3
@@ -76,13 +77,9 @@ def plot(rows, path: Path) -> None:
 
 
 def main() -> None:
-    import numba
-
     rows = measure()
     RESULTS.mkdir(exist_ok=True)
-    meta = {"machine": platform.processor() or platform.machine(), "cpus": __import__("os").cpu_count(),
-            "numba_threads": numba.get_num_threads(), "python": platform.python_version(),
-            "runs": RUNS}
+    meta = {**machine_meta(), "runs": RUNS}
     (RESULTS / "hinge_targets.json").write_text(json.dumps({"meta": meta, "rows": rows}, indent=1))
     plot(rows, RESULTS / "hinge_targets.png")
 

@@ -60,7 +60,9 @@ def build_parser() -> argparse.ArgumentParser:
     sim.add_argument("--fold-percent", type=float, default=100.0,
                      help="scale all target angles, -100…100 (default 100)")
     sim.add_argument("--solver", default="paper", choices=SOLVERS,
-                     help="iteration strategy: paper (the paper's local/global map) or rigid "
+                     help="iteration strategy: paper (the paper's local/global map), "
+                          "anderson (the same map, safeguarded Anderson acceleration), lbfgs "
+                          "(L-BFGS on the same energy, K as initial Hessian) or rigid "
                           "(panels as rigid bodies, Levenberg-Marquardt; far fewer iterations "
                           "on long panels, rigid panels only); default: paper")
     sim.add_argument("--tolerance", type=_positive, default=1e-8,

@@ -24,6 +24,17 @@ def _nullable(values) -> list:
     return [float(v) if np.isfinite(v) else None for v in np.asarray(values, dtype=float)]
 
 
+def _iteration_cost(result) -> dict:
+    """Mean strategy time per iteration (s) and its ratio to one bare K⁻¹ solve."""
+    t = result.timings_s
+    if not result.iterations or "bare_solve" not in t:
+        return {}
+    per_iteration = (t["projection"] + t["solve"]) / result.iterations
+    return {"per_iteration_s": per_iteration,
+            "per_iteration_vs_bare_solve": per_iteration / t["bare_solve"]
+            if t["bare_solve"] > 0 else None}
+
+
 def report_dict(result, pattern, mesh, settings: dict) -> dict:
     """The JSON report of a run (contract in DESIGN.md), plus the settings used.
 
@@ -47,6 +58,7 @@ def report_dict(result, pattern, mesh, settings: dict) -> dict:
         "hinge_width_mm": _nullable(mesh.hinge_width),
         "subdivisions": mesh.subdivisions.tolist(),
         "timings_s": {k: float(v) for k, v in result.timings_s.items()},
+        **_iteration_cost(result),
         "settings": settings,
         "machine": {"python": platform.python_version(), "numba": numba.__version__,
                     "numba_threads": numba.get_num_threads(),

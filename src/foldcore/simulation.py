@@ -19,6 +19,7 @@ from .system import System
 ALPHA_UPDATE_EVERY = 10  # iterations between α-schedule updates (each costs a refactor)
 STOP_ENTER = 1e-3  # rad past its bound before a passive strip becomes a stop
 STOP_LEAVE = 1e-3  # rad back inside its interval before a stop is released
+BARE_SOLVE_REPEATS = 5  # solves timed for the per-iteration cost floor
 
 
 @dataclass
@@ -49,7 +50,8 @@ class Result:
     energy : (iterations,) float, energy before each global step, mm⁵
     iterations : int
     converged : bool
-    timings_s : dict with ``setup``, ``projection``, ``solve``, ``total`` (seconds)
+    timings_s : dict with ``setup``, ``projection``, ``solve``, ``total`` and, after
+        :meth:`Simulation.run`, ``bare_solve`` (one K⁻¹ solve, the floor) (seconds)
     """
 
     positions: np.ndarray
@@ -87,10 +89,14 @@ class Simulation:
     mesh : ThickMesh
     pattern : CreasePattern
         The pattern the mesh was made from (targets, assignments, measurement).
-    solver : {"paper", "rigid"}
+    solver : {"paper", "anderson", "lbfgs", "rigid"}
         Iteration strategy. ``"paper"``: the paper's plain local/global map
         (every element a soft spring; iterations grow with panel length /
-        thickness). ``"rigid"``: rigid panels as rigid bodies, passive hinges
+        thickness). ``"anderson"``/``"lbfgs"``: the same local step and K,
+        accelerated (safeguarded Anderson; L-BFGS with K as initial Hessian,
+        :mod:`foldcore.accelerated`); their ``iterations`` are outer
+        iterations (a refused Anderson point or a line-search trial costs one
+        more local step inside the same iteration). ``"rigid"``: rigid panels as rigid bodies, passive hinges
         bent as one arc whose angle is a bounded unknown, Levenberg–Marquardt
         with geodesic acceleration (:mod:`foldcore.rigid_body`); needs a mesh
         of rigid panels and bending hinges. Its ``iterations`` are outer
@@ -145,11 +151,14 @@ class Simulation:
         self.energy_history: list[float] = []
         self.timings = {"setup": time.perf_counter() - start, "projection": 0.0, "solve": 0.0}
         self.length_scale = float(np.ptp(pattern.vertices, axis=0).max())
-        self._rigid = None
+        self._rigid = self._accelerated = None
         if solver == "rigid":
             from .rigid_body import RigidBodySolver
             self._rigid = RigidBodySolver(self)
             self.x = self._rigid.x
+        elif solver in ("anderson", "lbfgs"):
+            from .accelerated import AndersonSolver, LbfgsSolver
+            self._accelerated = (AndersonSolver if solver == "anderson" else LbfgsSolver)(self)
 
     # ------------------------------------------------------------- actuation
     def set_fold_angles(self, angles) -> None:
@@ -214,6 +223,9 @@ class Simulation:
         """One iteration of the strategy; returns the largest vertex displacement (mm)."""
         if self._rigid is not None:
             energy, moved = self._rigid_iteration()
+        elif self._accelerated is not None:
+            energy, moved = self._accelerated.step()
+            self.x = self._accelerated.x
         else:
             energy, moved = self._paper_iteration()
         self.energy_history.append(energy)
@@ -223,20 +235,45 @@ class Simulation:
 
     def _paper_iteration(self) -> tuple[float, float]:
         """Local step (projections) then global solve; (energy before, largest move)."""
+        energy, rhs = self.local_step(self.x)
+        new_x = self.global_step(rhs)
+        moved = float(np.abs(new_x - self.x).max())
+        self.x = new_x
+        return energy, moved
+
+    def local_step(self, x: np.ndarray) -> tuple[float, np.ndarray]:
+        """Project every element at ``x`` and gather the right-hand side.
+
+        Parameters
+        ----------
+        x : (N, 3) float, mm
+            Positions to project at (need not be ``self.x``).
+
+        Returns
+        -------
+        energy : float
+            E(x) = Σ w‖C S x − R T‖² + pin terms, mm⁵, with the projections at x.
+        rhs : (N, 3) float
+            b(x) = Σ w Sᵀ R T + pin terms (an internal buffer: copy to keep it).
+            With K fixed, ∇E(x) = 2 (K x − b(x)) and the global step is K⁻¹ b(x).
+        """
         t0 = time.perf_counter()
-        energy = sum(run.project(self.x, self._targets, w)
+        energy = sum(run.project(x, self._targets, w)
                      for run, w in zip(self._runs, self.system.weights))
-        self._update_stops()
+        self._update_stops(x)
         t1 = time.perf_counter()
         rhs = self.system.rhs(self._targets, self._rhs)
-        energy += self._add_pin_terms(rhs)
-        new_x = self.system.factor.solve(rhs)
-        t2 = time.perf_counter()
+        energy += self._add_pin_terms(rhs, x)
         self.timings["projection"] += t1 - t0
-        self.timings["solve"] += t2 - t1
-        moved = float(np.abs(new_x - self.x).max())
-        self.x = np.ascontiguousarray(new_x)
-        return energy, moved
+        self.timings["solve"] += time.perf_counter() - t1
+        return energy, rhs
+
+    def global_step(self, rhs: np.ndarray) -> np.ndarray:
+        """K⁻¹ rhs, (N, 3) mm, C-contiguous; its time counts as solve time."""
+        t0 = time.perf_counter()
+        out = np.ascontiguousarray(self.system.factor.solve(rhs))
+        self.timings["solve"] += time.perf_counter() - t0
+        return out
 
     def _rigid_iteration(self) -> tuple[float, float]:
         """One rigid-body step; assembly counts as projection time."""
@@ -274,7 +311,22 @@ class Simulation:
                 converged = True
                 break
         self.timings["total"] = time.perf_counter() - start + self.timings["setup"]
+        self.timings["bare_solve"] = self.bare_solve_seconds()
         return self.result(converged)
+
+    def bare_solve_seconds(self, repeats: int = BARE_SOLVE_REPEATS) -> float:
+        """Median time (s) of one K⁻¹ solve of an (N, 3) right-hand side: the cost floor.
+
+        ``Result.timings_s["bare_solve"]``; the report divides the mean
+        iteration time by it (``per_iteration_vs_bare_solve``).
+        """
+        rhs = np.ascontiguousarray(self.x)
+        times = []
+        for _ in range(int(repeats)):
+            t0 = time.perf_counter()
+            self.system.factor.solve(rhs)
+            times.append(time.perf_counter() - t0)
+        return float(np.median(times))
 
     # ------------------------------------------------------------- measuring
     @property
@@ -336,14 +388,14 @@ class Simulation:
             self.stops = np.zeros(len(self._hinges.group), dtype=bool)
             self._excess = np.zeros(len(self._hinges.group))
 
-    def _update_stops(self) -> None:
-        """Stiffen passive strips bent past their max angle; release them once back inside."""
+    def _update_stops(self, x: np.ndarray) -> None:
+        """Stiffen passive strips bent past their max angle at ``x``; release them once back inside."""
         if self._stop_factor == 1.0 or self._hinges is None:
             return
         if not self._passive.any() and not self.stops.any():
             return  # all actuated: no estimate to check (stops only on passive strips)
         g = self._hinges.group
-        limit_excess(self.x, g.indptr, g.indices, self._hinges.params, self._excess)
+        limit_excess(x, g.indptr, g.indices, self._hinges.params, self._excess)
         excess = np.where(self._passive, self._excess, -np.inf)
         stops = np.where(self.stops, excess > -STOP_LEAVE, excess > STOP_ENTER)
         if np.array_equal(stops, self.stops):
@@ -368,15 +420,15 @@ class Simulation:
         self._pin_weights = weights
         self.system.set_pin_weights(weights)
 
-    def _add_pin_terms(self, rhs: np.ndarray) -> float:
+    def _add_pin_terms(self, rhs: np.ndarray, x: np.ndarray) -> float:
         if not self._position_targets:
-            rhs[0] += self._pin_weights[0] * self.x[0]
+            rhs[0] += self._pin_weights[0] * x[0]
             return 0.0
         energy = 0.0
         for t in self._position_targets.values():
             w = t.alpha * self.system.reference_weight
             np.add.at(rhs, t.vertices, w * t.positions)
-            energy += w * float(((self.x[t.vertices] - t.positions) ** 2).sum())
+            energy += w * float(((x[t.vertices] - t.positions) ** 2).sum())
         return energy
 
     def _advance_alpha(self) -> None:

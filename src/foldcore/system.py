@@ -78,6 +78,9 @@ class System:
         weights dimensionless.
     weights : list of (n_g,) float
         Current element weights of each group, mm³ (start: the groups' own).
+    version : int
+        Number of refactorisations since construction: a change tells an
+        accelerated strategy that K changed and its history is stale.
     """
 
     def __init__(self, groups, n_vertices: int, backend: str = "auto"):
@@ -89,6 +92,7 @@ class System:
         indices = np.concatenate([g.indices for g in self.groups])
         self.v_indptr, self.v_slots = vertex_slots(indices, n_vertices)
         self._pins = np.zeros(n_vertices)
+        self.version = 0
         self.factor = Factor(self._with_pins(), backend)
 
     def _assemble(self) -> None:
@@ -102,7 +106,7 @@ class System:
             return False
         self.weights[group] = np.array(weights, dtype=float)
         self._assemble()
-        self.factor.refactor(self._with_pins())
+        self._refactor()
         return True
 
     def _with_pins(self):
@@ -113,8 +117,16 @@ class System:
         if np.array_equal(pins, self._pins):
             return False
         self._pins = np.array(pins, dtype=float)
-        self.factor.refactor(self._with_pins())
+        self._refactor()
         return True
+
+    def _refactor(self) -> None:
+        self.factor.refactor(self._with_pins())
+        self.version += 1
+
+    def apply(self, x: np.ndarray) -> np.ndarray:
+        """K x with the pins, (N, 3) for (N, 3) positions in mm (result in mm⁴)."""
+        return self.matrix @ x + self._pins[:, None] * x
 
     def rhs(self, targets: np.ndarray, out: np.ndarray) -> np.ndarray:
         """Gather Σ w·(R T) per vertex from the stacked slot targets (nnz, 3)."""

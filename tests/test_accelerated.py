@@ -1,0 +1,102 @@
+"""Accelerated local/global strategies (Anderson, K-preconditioned L-BFGS).
+
+What is tested and why the tolerances:
+
+* With only actuated hinges every projection is an exact nearest-point
+  projection, so the local/global energy is a true potential: the plain map
+  never raises it, and both safeguards (Anderson's energy test, L-BFGS's
+  Armijo search) keep every recorded energy non-increasing. Allowed rise:
+  1e-12 of the start energy (rounding of a sum of ~10² terms).
+* L-BFGS with H₀ = K⁻¹ and no history takes exactly the paper's step:
+  first iterates equal to rounding (1e-12 mm on a 10 mm part).
+* Convergence: a single actuated hinge is compatible, so the fold angle goes
+  to the target; 0.01° is the accuracy issue 4 asks for. The iteration bound
+  (400) is what acceleration buys on panels 5 H long: the plain map needs
+  ~10⁴ iterations there (bench/results/convergence.json), checked below by
+  the paper's map still being > 1° away after the same budget.
+"""
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from foldcore import patterns
+from foldcore.cli import main
+from foldcore.io import write_fold
+from foldcore.simulation import Simulation
+from foldcore.thicken import thicken
+
+H = 1.0  # mm
+BUDGET = 400
+
+
+def hinge(ratio: float = 5.0):
+    pattern = patterns.single_hinge(panel_length=ratio * H, depth=10.0, angle=90.0, width=2.0)
+    return pattern, thicken(pattern, H, subdivisions=4)
+
+
+def iterations_to(sim, error_deg: float, budget: int) -> int | None:
+    for _ in range(budget):
+        sim.step()
+        if abs(sim.fold_angles()[0] - 90.0) <= error_deg:
+            return sim.iterations
+    return None
+
+
+@pytest.mark.parametrize("solver", ["anderson", "lbfgs"])
+def test_accelerated_strategies_reach_the_target(solver):
+    pattern, mesh = hinge()
+    assert iterations_to(Simulation(mesh, pattern, solver=solver), 0.01, BUDGET) is not None
+    plain = Simulation(mesh, pattern, solver="paper")
+    assert iterations_to(plain, 1.0, BUDGET) is None
+
+
+@pytest.mark.parametrize("solver", ["anderson", "lbfgs"])
+def test_safeguards_keep_the_energy_non_increasing(solver):
+    pattern, mesh = hinge()
+    result = Simulation(mesh, pattern, solver=solver).run(tolerance=0, max_iterations=150)
+    rises = np.diff(result.energy)
+    assert rises.max() <= 1e-12 * result.energy[0]
+
+
+def test_first_lbfgs_step_is_the_paper_step():
+    pattern, mesh = hinge()
+    paper, lbfgs = (Simulation(mesh, pattern, solver=s) for s in ("paper", "lbfgs"))
+    paper.step()
+    lbfgs.step()
+    np.testing.assert_allclose(lbfgs.positions, paper.positions, rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize("solver", ["anderson", "lbfgs"])
+def test_changing_pins_mid_run_keeps_the_iteration_sound(solver):
+    """A new position target refactors K: the stale history must be dropped."""
+    pattern, mesh = hinge()
+    sim = Simulation(mesh, pattern, solver=solver)
+    for _ in range(10):
+        sim.step()
+    far = sim.nearest_vertex(sim.positions.max(axis=0))
+    version = sim.system.version
+    sim.add_position_target([far], alpha=1.0)  # pinned where it is: still compatible
+    assert sim.system.version == version + 1
+    assert iterations_to(sim, 0.01, BUDGET) is not None
+    assert np.isfinite(sim.positions).all()
+
+
+def test_cli_accepts_the_strategies_and_reports_the_iteration_cost(tmp_path):
+    pattern, _ = hinge()
+    src = tmp_path / "hinge.fold"
+    write_fold(src, pattern, thickness=H)
+    report = tmp_path / "r.json"
+    assert main(["simulate", str(src), "--solver", "lbfgs", "--subdivisions", "4",
+                 "--tolerance", "1e-11", "--max-iterations", str(BUDGET),
+                 "--report", str(report)]) == 0
+    data = json.loads(report.read_text())
+    assert abs(data["fold_angles_deg"][0] - 90.0) < 0.01
+    assert data["timings_s"]["bare_solve"] > 0
+    per_iteration = (data["timings_s"]["projection"] + data["timings_s"]["solve"]) \
+        / data["iterations"]
+    assert data["per_iteration_s"] == pytest.approx(per_iteration)
+    assert data["per_iteration_vs_bare_solve"] == pytest.approx(
+        per_iteration / data["timings_s"]["bare_solve"])
