@@ -46,6 +46,16 @@ class _Strategy:
         self.x = sim.x
         self.rejected = 0  # accelerated points refused (Anderson) / failed line searches (L-BFGS)
         self._version = sim.system.version
+        self._forget()
+
+    def restart(self, x: np.ndarray) -> None:
+        """Continue from positions ``x`` (N, 3) mm with an empty history."""
+        self.x = x
+        self._forget()
+
+    def _forget(self) -> None:
+        """Drop the history (each strategy knows its own)."""
+        raise NotImplementedError
 
     def _k_changed(self) -> bool:
         version = self.sim.system.version
@@ -60,15 +70,14 @@ class AndersonSolver(_Strategy):
     """
 
     def __init__(self, sim, memory: int = ANDERSON_MEMORY):
-        super().__init__(sim)
         self.memory = int(memory)
-        self._forget()
-        self._last = None  # (energy, G(x)) of the last accepted point
+        super().__init__(sim)
 
     def _forget(self) -> None:
         self._dg = deque(maxlen=self.memory)
         self._df = deque(maxlen=self.memory)
         self._prev = None  # (g, f) of the previous iteration
+        self._last = None  # (energy, G(x)) of the last accepted point
 
     def step(self) -> tuple[float, float]:
         sim = self.sim
@@ -108,9 +117,12 @@ class LbfgsSolver(_Strategy):
     """
 
     def __init__(self, sim, memory: int = LBFGS_MEMORY):
+        self.memory = int(memory)
         super().__init__(sim)
-        self._pairs = deque(maxlen=int(memory))
-        self._at = None  # (energy, gradient) already evaluated at self.x
+
+    def _forget(self) -> None:
+        self._pairs = deque(maxlen=self.memory)
+        self._at = None  # (energy, ½∇E) already evaluated at self.x
 
     def _evaluate(self, x: np.ndarray) -> tuple[float, np.ndarray]:
         energy, rhs = self.sim.local_step(x)

@@ -7,6 +7,7 @@ from __future__ import annotations
 import time
 from dataclasses import dataclass, field
 
+import numba
 import numpy as np
 
 import elements
@@ -19,6 +20,10 @@ from .system import System
 ALPHA_UPDATE_EVERY = 10  # iterations between α-schedule updates (each costs a refactor)
 STOP_ENTER = 1e-3  # rad past its bound before a passive strip becomes a stop
 STOP_LEAVE = 1e-3  # rad back inside its interval before a stop is released
+# Element-vertex slots below which the kernels run on one thread. Measured on the
+# 2-core Xeon, paper map, ms/iteration 1 vs 2 threads: Miura 2×2 (108 slots) 0.070 vs
+# 0.063 quiet / 2.3 with the cores busy; 5×5 (936) 0.41 vs 0.28; 10×10 (4 076) 1.77 vs 1.09.
+SERIAL_BELOW_SLOTS = 500
 BARE_SOLVE_REPEATS = 5  # solves timed for the per-iteration cost floor
 
 
@@ -50,7 +55,8 @@ class Result:
     energy : (iterations,) float, energy before each global step, mm⁵
     iterations : int
     converged : bool
-    timings_s : dict with ``setup``, ``projection``, ``solve``, ``total`` and, after
+    timings_s : dict with ``setup``, ``projection``, ``solve``, ``total`` (setup + every
+        :meth:`Simulation.run` so far) and, after
         :meth:`Simulation.run`, ``bare_solve`` (one K⁻¹ solve, the floor) (seconds)
     """
 
@@ -116,7 +122,12 @@ class Simulation:
         a position target on a long lever bends a small hinge far past it.
         Each change of the set of stops costs one numeric refactor.
     threads : int, optional
-        numba threads for the projection loop (default: numba's setting).
+        numba threads for the kernels of this simulation (set at each step,
+        so simulations in one process do not override each other). Default:
+        one thread below ``SERIAL_BELOW_SLOTS`` element-vertex slots (a
+        parallel launch costs more than it saves there, and on a busy machine
+        a launch can wait milliseconds for a descheduled thread, measured),
+        else numba's setting.
     """
 
     def __init__(self, mesh, pattern, solver: str = "paper", backend: str = "auto",
@@ -125,9 +136,6 @@ class Simulation:
         start = time.perf_counter()
         if solver not in SOLVERS:
             raise SimulationError(f"unknown solver {solver!r} (available: {', '.join(SOLVERS)})")
-        if threads is not None:
-            import numba
-            numba.set_num_threads(int(threads))
         self.mesh, self.pattern, self.solver = mesh, pattern, solver
         self.x = mesh.rest_positions.copy()
         self._runs, offset = [], 0
@@ -135,6 +143,7 @@ class Simulation:
             if len(g):
                 self._runs.append(_GroupRun(g, offset))
                 offset += len(g.indices)
+        self.threads = self._choose_threads(threads, offset)
         self._targets = np.zeros((offset, 3))
         self._rhs = np.zeros((mesh.n_vertices, 3))
         self.system = System([r.group for r in self._runs], mesh.n_vertices, backend)
@@ -214,6 +223,24 @@ class Simulation:
         del self._position_targets[name]
         self._update_pins()
 
+    def set_positions(self, positions) -> None:
+        """Start the next iteration from these vertex positions, (N, 3) mm.
+
+        For restarting from a saved or perturbed state; the targets, stops and
+        pins are unchanged. Not available with ``solver="rigid"``, whose state
+        is its panels' rigid motions.
+        """
+        x = np.asarray(positions, dtype=float)
+        if x.shape != self.x.shape or not np.isfinite(x).all():
+            raise SimulationError(f"positions must be a finite ({self.mesh.n_vertices}, 3) "
+                                  f"array of mm, got shape {x.shape}")
+        if self._rigid is not None:
+            raise SimulationError("solver 'rigid' keeps its panels rigid by construction: "
+                                  "its positions cannot be set")
+        self.x = np.ascontiguousarray(x.copy())
+        if self._accelerated is not None:
+            self._accelerated.restart(self.x)
+
     def nearest_vertex(self, point) -> int:
         """Id of the mesh vertex closest to a 3D point (mm), current positions."""
         return int(np.argmin(np.linalg.norm(self.x - np.asarray(point, float), axis=1)))
@@ -221,6 +248,7 @@ class Simulation:
     # ------------------------------------------------------------- iteration
     def step(self) -> float:
         """One iteration of the strategy; returns the largest vertex displacement (mm)."""
+        numba.set_num_threads(self.threads)
         if self._rigid is not None:
             energy, moved = self._rigid_iteration()
         elif self._accelerated is not None:
@@ -301,6 +329,7 @@ class Simulation:
         """
         start = time.perf_counter()
         converged = False
+        self.timings.setdefault("total", self.timings["setup"])
         for _ in range(int(max_iterations)):
             moved = self.step()
             if not np.isfinite(moved):
@@ -310,7 +339,7 @@ class Simulation:
             if moved <= tolerance * self.length_scale:
                 converged = True
                 break
-        self.timings["total"] = time.perf_counter() - start + self.timings["setup"]
+        self.timings["total"] += time.perf_counter() - start
         self.timings["bare_solve"] = self.bare_solve_seconds()
         return self.result(converged)
 
@@ -352,6 +381,16 @@ class Simulation:
                       np.array(self.energy_history), self.iterations, converged, timings)
 
     # --------------------------------------------------------------- private
+    @staticmethod
+    def _choose_threads(threads, slots: int) -> int:
+        if threads is None:
+            return 1 if slots < SERIAL_BELOW_SLOTS else numba.config.NUMBA_NUM_THREADS
+        if not (isinstance(threads, (int, np.integer)) and
+                1 <= threads <= numba.config.NUMBA_NUM_THREADS):
+            raise SimulationError(f"threads must be an integer in 1..{numba.config.NUMBA_NUM_THREADS},"
+                                  f" got {threads!r}")
+        return int(threads)
+
     def _checked_crease(self, e: int) -> int:
         if not 0 <= e < self.pattern.n_edges:
             raise SimulationError(f"edge {e} does not exist (0..{self.pattern.n_edges - 1})")

@@ -64,6 +64,11 @@ def gather(v_indptr, v_slots, slot_weight, targets, rhs):
 class System:
     """The global least-squares system of one thick mesh.
 
+    K alone is singular (free translation) and CHOLMOD may refuse it, so the
+    first factorisation already pins vertex 0 with ``reference_weight`` — the
+    anchor a Simulation without position targets uses (no second factorisation
+    at setup) — until :meth:`set_pin_weights` says otherwise.
+
     Parameters
     ----------
     groups : sequence of ElementGroup
@@ -92,6 +97,8 @@ class System:
         indices = np.concatenate([g.indices for g in self.groups])
         self.v_indptr, self.v_slots = vertex_slots(indices, n_vertices)
         self._pins = np.zeros(n_vertices)
+        if n_vertices:  # anchor vertex 0 (K alone is singular: free translation)
+            self._pins[0] = self.reference_weight
         self.version = 0
         self.factor = Factor(self._with_pins(), backend)
 
