@@ -22,6 +22,8 @@ Tolerances and why:
 """
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
@@ -29,6 +31,7 @@ from hypothesis import strategies as st
 
 from foldcore import patterns
 from foldcore.errors import FoldcoreError, MeshError
+from foldcore.io import read_fold_file
 from foldcore.simulation import Simulation
 from foldcore.thicken import thicken
 
@@ -154,6 +157,18 @@ def test_perturbed_start_converges_to_the_same_state(seed):
     sim.set_positions(sim.positions + noise)
     result = sim.run(tolerance=1e-12, max_iterations=400)
     assert abs(result.fold_angles_deg[0] - reference.fold_angles_deg[0]) < 1e-6
+
+
+DATA = Path(__file__).parent / "data"
+
+
+def test_regression_first_factorisation_is_anchored():
+    """Found by the random-vertex test: K was factored before its anchor pin and
+    CHOLMOD refused it (not positive definite) on this 45/90/135/90 vertex."""
+    stored = read_fold_file(DATA / "anchor_first_factor.fold")
+    mesh = thicken(stored.pattern, stored.thickness, subdivisions=2)
+    result = Simulation(mesh, stored.pattern).run(tolerance=1e-9, max_iterations=50)
+    assert np.isfinite(result.positions).all()
 
 
 vertex_sectors = st.floats(30.0, 150.0).map(lambda a: [a, 180.0 - a, 180.0 - a, a])
