@@ -413,3 +413,24 @@ def test_name_collision_warns(saved_registry):
 def test_registry_left_untouched():
     assert elements.get("rigid_panel").__module__ == "elements.rigid_panel"
     assert "test_fresh_type" not in elements.registered()
+
+
+@pytest.mark.parametrize("cond", [1.0, 1e3, 1e6])
+def test_polar_rotation_matches_the_svd_kabsch_rotation(cond):
+    """The allocation-free Newton polar factor equals U·diag(1,1,±1)·Vᵀ.
+
+    Both are exact up to rounding; the polar factor's sensitivity is
+    ‖A‖/(σ₂+σ₃) ≤ cond, so the allowed gap is 10·cond·ε. Inverted matrices
+    (det < 0) take the SVD path and must still give det = +1.
+    """
+    from elements._rotation import best_rotation, polar_rotation
+
+    rng = np.random.default_rng(int(cond))
+    for k in range(300):
+        q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+        v, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+        sigma = np.array([1.0, rng.uniform(1.0 / cond, 1.0), 1.0 / cond])
+        a = q @ np.diag(sigma) @ v.T * 10.0 ** rng.uniform(-6, 6)
+        r = np.array(polar_rotation(*a.ravel())).reshape(3, 3)
+        np.testing.assert_allclose(r, best_rotation(a), atol=10 * cond * np.finfo(float).eps)
+        assert np.linalg.det(r) == pytest.approx(1.0, abs=1e-12)

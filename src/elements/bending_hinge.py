@@ -140,7 +140,7 @@ def project(x, ids, rest, params, out, state):
     ids : (8,) vertex ids in the order drawn in the module docstring
     rest : (8, 3) centred rest shape in the local frame, mm
     params : (7,) see ``HINGE_PARAMS``
-    out : (8, 3) written: the rotated target, mm (also used as scratch)
+    out : (8, 3) written: the rotated target, mm (holds the unrotated one first)
     state : (1,) written: the bend angle used, rad
     """
     exact = params[EXACT] > 0.5
@@ -150,8 +150,7 @@ def project(x, ids, rest, params, out, state):
                           params[MAX_ANGLE])
     state[0] = phi
     bent_shape(rest, params[W], phi, exact, out)
-    target = out.copy()
-    return fit_rotated(x, ids, target, out)
+    return fit_rotated(x, ids, out, out)
 
 
 @njit(parallel=True, cache=True)
