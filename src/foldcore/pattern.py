@@ -14,6 +14,10 @@ from .planar import crossing_pairs, derive_faces, signed_area
 #: Assignments foldcore simulates. ``C`` (cut) and ``J`` (join) are refused.
 ASSIGNMENTS = ("M", "V", "B", "F", "U")
 DEFAULT_MAX_ANGLE_DEG = 180.0
+#: Largest coordinate magnitude, mm; beyond it squared lengths and areas overflow.
+MAX_COORDINATE_MM = 1e100
+#: Smallest sheet size (largest extent), mm; below it squared lengths and areas underflow.
+MIN_EXTENT_MM = 1e-100
 
 
 class CreasePattern:
@@ -22,7 +26,8 @@ class CreasePattern:
     Parameters
     ----------
     vertices : (V, 2) array_like of float
-        Vertex coordinates in the flat sheet, mm.
+        Vertex coordinates in the flat sheet, mm; within ±:data:`MAX_COORDINATE_MM`,
+        the sheet at least :data:`MIN_EXTENT_MM` across.
     edges : (E, 2) array_like of int
         Vertex ids of each edge.
     assignments : (E,) sequence of str
@@ -240,7 +245,20 @@ def _as_vertices(vertices, source: str) -> np.ndarray:
     if len(bad):
         raise PatternError(f"{source}: vertex {bad[0]} has a non-finite coordinate "
                            f"{tuple(v[bad[0]].tolist())}")
+    _check_scale(v, source)
     return v
+
+
+def _check_scale(v: np.ndarray, source: str):
+    """Refuse coordinates whose lengths² and areas cannot be computed in float64."""
+    huge = np.flatnonzero((np.abs(v) > MAX_COORDINATE_MM).any(axis=1))
+    if len(huge):
+        raise PatternError(f"{source}: vertex {huge[0]} {tuple(v[huge[0]].tolist())} is "
+                           f"beyond ±{MAX_COORDINATE_MM:g} mm (wrong units?)")
+    extent = float(np.ptp(v, axis=0).max()) if len(v) else 0.0
+    if 0 < extent < MIN_EXTENT_MM:
+        raise PatternError(f"{source}: the pattern is only {extent:g} mm across, smaller "
+                           f"than {MIN_EXTENT_MM:g} mm (wrong units?)")
 
 
 def _as_edges(edges, n_vertices: int, source: str) -> np.ndarray:

@@ -56,6 +56,8 @@ WIDTH_KEY = "foldcore:edges_width"
 MAX_ANGLE_KEY = "foldcore:edges_maxAngle"
 THICKNESS_KEY = "foldcore:thickness"
 TARGET_KEY = "foldcore:edges_targetAngle"
+#: What a JSON array may be in a FOLD dict: a list, or a tuple from a Python caller.
+ARRAY = (list, tuple)
 
 
 @dataclass(frozen=True)
@@ -92,7 +94,20 @@ def read_fold(path) -> CreasePattern:
 def read_fold_file(path) -> FoldFile:
     """Read a FOLD file: its crease pattern and ``foldcore:thickness`` (mm)."""
     source = os.fspath(path)
-    return fold_file_from_dict(_parse_json(read_bytes(source), source), source)
+    return parse_fold(read_bytes(source), source)
+
+
+def parse_fold(data: bytes, source: str = "<fold>") -> FoldFile:
+    """A FOLD file's contents (UTF-8 JSON bytes) as a :class:`FoldFile`.
+
+    Parameters
+    ----------
+    data : bytes
+        The file's bytes.
+    source : str
+        Name used in error messages (the file name).
+    """
+    return fold_file_from_dict(_parse_json(data, source), source)
 
 
 def pattern_from_fold_dict(d, source: str = "<fold>") -> CreasePattern:
@@ -123,7 +138,9 @@ def fold_file_from_dict(d, source: str = "<fold>") -> FoldFile:
         vertices=vertices, edges=edges,
         assignments=_assignments(d, vertices, edges, source),
         fold_angles=_per_edge(d, key, n, source),
-        widths=None if widths is None else [None if w is None else w * scale for w in widths],
+        widths=None if widths is None else [
+            None if w is None else _scaled(w, scale, f"{WIDTH_KEY}[{e}] (edge {e})", source)
+            for e, w in enumerate(widths)],
         max_angles=None if max_angles is None else
         [DEFAULT_MAX_ANGLE_DEG if m is None else m for m in max_angles],
         faces=_faces(d, len(vertices), source), source=source)
@@ -145,6 +162,8 @@ def read_bytes(path, limit: int | None = None) -> bytes:
             data = fh.read(limit + 1)
     except OSError as exc:
         raise PatternError(f"{source}: cannot read the file ({exc.strerror or exc})") from None
+    except ValueError as exc:  # e.g. a NUL byte in the path
+        raise PatternError(f"{source}: cannot read the file (invalid path: {exc})") from None
     if len(data) > limit:
         _fail(source, f"file is larger than the {limit}-byte limit")
     return data
@@ -189,21 +208,22 @@ def _unit_scale(d: dict, source: str) -> tuple[str, float]:
 def _coords(d: dict, scale: float, source: str) -> list[list[float]]:
     out = []
     for i, row in enumerate(_required_list(d, "vertices_coords", source)):
-        xyz = [_number(x) for x in row] if isinstance(row, list) else []
-        if len(xyz) < 2 or None in xyz:
+        xyz = [_number(x) for x in row] if isinstance(row, ARRAY) else []
+        if not 2 <= len(xyz) <= 3 or None in xyz:
             _fail(source, f"vertices_coords[{i}] (vertex {i}) must be 2 or 3 finite "
                           f"numbers, got {_short(row)}")
-        if any(z != 0 for z in xyz[2:]):
+        if len(xyz) == 3 and xyz[2] != 0:
             _fail(source, f"vertex {i} has z = {xyz[2]:g}; the crease pattern "
                           "(frame 0) must be flat (z = 0)")
-        out.append([xyz[0] * scale, xyz[1] * scale])
+        out.append([_scaled(x, scale, f"vertices_coords[{i}] (vertex {i})", source)
+                    for x in xyz[:2]])
     return out
 
 
 def _edges(d: dict, n_vertices: int, source: str) -> list[list[int]]:
     out = []
     for i, row in enumerate(_required_list(d, "edges_vertices", source)):
-        if not isinstance(row, list) or len(row) != 2:
+        if not isinstance(row, ARRAY) or len(row) != 2:
             _fail(source, f"edges_vertices[{i}] (edge {i}) must be [u, v], got {_short(row)}")
         ids = [_index(x, n_vertices) for x in row]
         if None in ids:
@@ -215,13 +235,13 @@ def _edges(d: dict, n_vertices: int, source: str) -> list[list[int]]:
 
 def _faces(d: dict, n_vertices: int, source: str) -> list[list[int]] | None:
     raw = d.get("faces_vertices")
-    if raw is None or raw == []:
+    if raw is None or isinstance(raw, ARRAY) and not raw:
         return None
-    if not isinstance(raw, list):
+    if not isinstance(raw, ARRAY):
         _fail(source, f"faces_vertices must be a list, got {type(raw).__name__}")
     out = []
     for i, row in enumerate(raw):
-        ids = [_index(x, n_vertices) for x in row] if isinstance(row, list) else [None]
+        ids = [_index(x, n_vertices) for x in row] if isinstance(row, ARRAY) else [None]
         if None in ids:
             _fail(source, f"faces_vertices[{i}] (face {i}) must list vertex ids "
                           f"(there are {n_vertices} vertices), got {_short(row)}")
@@ -245,7 +265,8 @@ def _default_assignments(vertices, edges, source: str) -> list[str]:
     v = np.asarray(vertices, dtype=np.float64).reshape(-1, 2)
     e = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
     try:
-        faces = derive_faces(v, e, np.zeros(len(e), dtype=bool), source)
+        with np.errstate(all="ignore"):  # huge coordinates: CreasePattern refuses them
+            faces = derive_faces(v, e, np.zeros(len(e), dtype=bool), source)
     except PatternError:
         raise
     except Exception:  # malformed graph: let CreasePattern name the problem
@@ -275,7 +296,16 @@ def _thickness(d: dict, scale: float, source: str) -> float | None:
     value = _number(raw)
     if value is None or not value > 0:
         _fail(source, f"{THICKNESS_KEY} must be a positive number, got {_short(raw)}")
-    return value * scale
+    return _scaled(value, scale, THICKNESS_KEY, source)
+
+
+def _scaled(value: float, scale: float, what: str, source: str) -> float:
+    """``value`` × the frame_unit ``scale`` (mm); PatternError if that overflows."""
+    mm = value * scale
+    if not np.isfinite(mm):
+        _fail(source, f"{what} = {value:g} overflows when converted to mm "
+                      f"(× {scale:g}, frame_unit)")
+    return mm
 
 
 def _build(args: dict) -> CreasePattern:
@@ -294,20 +324,28 @@ def _fail(source: str, message: str):
 
 
 def _short(value, limit: int = 60) -> str:
-    text = json.dumps(value) if isinstance(value, (list, dict, str, type(None))) else repr(value)
+    """``value`` for an error message: JSON-like, at most ``limit`` characters."""
+    try:
+        text = json.dumps(value) if isinstance(value, (*ARRAY, dict, str, type(None))) \
+            else repr(value)
+    except (TypeError, ValueError, RecursionError):  # not JSON (a Python caller's object)
+        try:
+            text = repr(value)
+        except RecursionError:
+            text = f"<nested {type(value).__name__}>"
     return text if len(text) <= limit else text[:limit - 3] + "..."
 
 
 def _required_list(d: dict, key: str, source: str) -> list:
     if key not in d:
         _fail(source, f"missing required key {key!r}")
-    if not isinstance(d[key], list):
+    if not isinstance(d[key], ARRAY):
         _fail(source, f"{key} must be a list, got {type(d[key]).__name__}")
     return d[key]
 
 
 def _check_length(raw, key: str, n_edges: int, source: str):
-    if not isinstance(raw, list):
+    if not isinstance(raw, ARRAY):
         _fail(source, f"{key} must be a list, got {type(raw).__name__}")
     if len(raw) != n_edges:
         _fail(source, f"{key} has {len(raw)} entries for {n_edges} edges "
@@ -401,7 +439,8 @@ def atomic_write(path):
     """
     target = os.fspath(path)
     folder, name = os.path.split(os.path.abspath(target))
-    tmp = os.path.join(folder, f".{name}.{os.getpid()}.{secrets.token_hex(4)}.tmp")
+    # a prefix of the name: the temporary name must fit NAME_MAX (255 bytes) too
+    tmp = os.path.join(folder, f".{name[:50]}.{os.getpid()}.{secrets.token_hex(4)}.tmp")
     fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666)
     try:
         with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as fh:

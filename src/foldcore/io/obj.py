@@ -8,7 +8,11 @@ Mesh (lengths in mm)
   Other statements (``vt``, ``vn``, ``o``, ``g``, ``s``, ``usemtl``...) and
   ``#`` comments are ignored.
 * STL, ASCII or binary: facets with z = 0. Vertices with exactly equal
-  coordinates are merged, numbered in order of first appearance.
+  coordinates are merged, numbered in order of first appearance. A binary STL
+  must be exactly 84 + 50 × (triangle count) bytes; an ASCII STL's every
+  ``outer loop`` needs its ``endloop`` (a truncated file is refused).
+
+Mesh and hinge files above :data:`foldcore.io.MAX_FILE_BYTES` are refused unread.
 
 Each face is a panel; clockwise faces are reversed (with a warning).
 
@@ -107,7 +111,23 @@ def read_mesh(path, hinges=None) -> CreasePattern:
     source = os.fspath(path)
     hinge_source = default_hinge_path(source) if hinges is None else os.fspath(hinges)
     vertices, faces = read_polygons(source)
-    table = parse_hinges(_text(read_bytes(hinge_source)), hinge_source, len(mesh_edges(faces)))
+    return mesh_pattern(vertices, faces, read_bytes(hinge_source), source, hinge_source)
+
+
+def mesh_pattern(vertices, faces, hinge_data: bytes, source: str,
+                 hinge_source: str) -> CreasePattern:
+    """The pattern of a parsed mesh and the contents of its hinge file.
+
+    Parameters
+    ----------
+    vertices, faces
+        :func:`parse_polygons` output.
+    hinge_data : bytes
+        The hinge file's bytes.
+    source, hinge_source : str
+        Names of the mesh and hinge files, used in error messages.
+    """
+    table = parse_hinges(_text(hinge_data), hinge_source, len(mesh_edges(faces)))
     return pattern_from_mesh(vertices, faces, table, f"{source} (hinges {hinge_source})")
 
 
@@ -124,15 +144,24 @@ def default_hinge_path(mesh_path) -> str:
 def read_polygons(path) -> tuple[np.ndarray, list[np.ndarray]]:
     """Vertices ((V, 2) float, mm) and 0-based faces of an OBJ or STL file."""
     source = os.fspath(path)
-    suffix = Path(source).suffix.lower()
-    if suffix not in (".obj", ".stl"):
-        raise PatternError(f"{source}: not an OBJ or STL file")
-    data = read_bytes(source)
-    vertices, faces = parse_obj(_text(data), source) if suffix == ".obj" \
+    _mesh_suffix(source)
+    return parse_polygons(read_bytes(source), source)
+
+
+def parse_polygons(data: bytes, source: str) -> tuple[np.ndarray, list[np.ndarray]]:
+    """Vertices and faces of OBJ or STL contents; ``source``'s suffix names the format."""
+    vertices, faces = parse_obj(_text(data), source) if _mesh_suffix(source) == ".obj" \
         else parse_stl(data, source)
     if not faces:
         raise PatternError(f"{source}: the mesh has no faces")
     return vertices, faces
+
+
+def _mesh_suffix(source: str) -> str:
+    suffix = Path(source).suffix.lower()
+    if suffix not in (".obj", ".stl"):
+        raise PatternError(f"{source}: not an OBJ or STL file")
+    return suffix
 
 
 def parse_obj(text: str, source: str) -> tuple[np.ndarray, list[np.ndarray]]:
@@ -180,9 +209,21 @@ def parse_stl(data: bytes, source: str) -> tuple[np.ndarray, list[np.ndarray]]:
         records = np.frombuffer(data, dtype=_STL_RECORD, count=count, offset=84)
         polygons = [(f"{source}, facet {i}", tri.tolist())
                     for i, tri in enumerate(records["v"].astype(np.float64))]
+    elif b"\0" in data:  # ASCII STL is text: a damaged binary STL
+        _bad_binary_stl(data, count, source)
     else:
         polygons = _ascii_stl_loops(_text(data), source)
     return _merge_vertices(polygons)
+
+
+def _bad_binary_stl(data: bytes, count: int, source: str):
+    """Refuse binary data that is not a whole binary STL (truncated, wrong count)."""
+    if len(data) < 84:
+        raise PatternError(f"{source}: not an ASCII STL (NUL bytes) and only {len(data)} "
+                           "bytes, too short for a binary STL (80-byte header + count)")
+    raise PatternError(f"{source}: binary STL header says {count} triangles "
+                       f"({84 + 50 * count} bytes), but the file has {len(data)} bytes "
+                       "(truncated or damaged)")
 
 
 def _ascii_stl_loops(text: str, source: str) -> list[tuple[str, list]]:
@@ -191,6 +232,9 @@ def _ascii_stl_loops(text: str, source: str) -> list[tuple[str, list]]:
     for lineno, tokens in _lines(text):
         where, word = f"{source}, line {lineno}", tokens[0].lower()
         if word == "outer":
+            if current is not None:
+                raise PatternError(f"{where}: 'outer loop' before the 'endloop' of the loop "
+                                   f"at {current[0].rsplit(', ', 1)[-1]}")
             current = (where, [])
         elif word == "vertex":
             xyz = [_float(t) for t in tokens[1:]]
@@ -201,6 +245,9 @@ def _ascii_stl_loops(text: str, source: str) -> list[tuple[str, list]]:
         elif word == "endloop" and current is not None:
             loops.append(current)
             current = None
+    if current is not None:
+        raise PatternError(f"{current[0]}: this 'outer loop' has no 'endloop' "
+                           "(file truncated?)")
     return loops
 
 
