@@ -805,3 +805,12 @@ def test_atomic_write_long_name(tmp_path):
     fio.write_fold(target, BASES[0])
     assert os.listdir(tmp_path) == [target.name]
     assert_valid(fio.read_fold(target))
+
+
+def test_a_huge_bad_line_gives_a_short_message():
+    """A refusal quotes at most ~60 characters of the offending line."""
+    from foldcore.io.obj import parse_obj
+
+    with pytest.raises(PatternError) as err:
+        parse_obj("v 0 0\nv 1 0\nv 0 1\nf 1 2 " + "x" * 100_000 + "\n", "big.obj")
+    assert "big.obj, line 4" in str(err.value) and len(str(err.value)) < 300

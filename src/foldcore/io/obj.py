@@ -53,7 +53,7 @@ import numpy as np
 
 from ..errors import PatternError
 from ..pattern import DEFAULT_MAX_ANGLE_DEG, CreasePattern
-from .fold import _build, atomic_write, read_bytes
+from .fold import _build, _short, atomic_write, read_bytes
 
 HINGE_SUFFIX = ".hinges"
 HINGE_KINDS = ("M", "V", "F", "U")
@@ -187,7 +187,7 @@ def _obj_vertex(tokens: list[str], where: str) -> tuple[float, float]:
     xyz = [_float(t) for t in tokens[1:4]]
     if len(xyz) < 2 or None in xyz:
         raise PatternError(f"{where}: expected 'v x y [z]' with finite numbers, "
-                           f"got {' '.join(tokens)!r}")
+                           f"got {_short(' '.join(tokens))}")
     if len(xyz) == 3 and xyz[2] != 0:
         raise PatternError(f"{where}: vertex has z = {xyz[2]:g}; the pattern must lie "
                            "flat in the plane z = 0")
@@ -198,7 +198,7 @@ def _obj_face(tokens: list[str], n_read: int, where: str) -> list[int]:
     ids = [_int(t.split("/", 1)[0]) for t in tokens[1:]]
     if len(ids) < 3 or None in ids or 0 in ids:
         raise PatternError(f"{where}: expected 'f i j k ...' with at least 3 non-zero "
-                           f"vertex ids (1-based), got {' '.join(tokens)!r}")
+                           f"vertex ids (1-based), got {_short(' '.join(tokens))}")
     return [i - 1 if i > 0 else n_read + i for i in ids]
 
 
@@ -240,7 +240,7 @@ def _ascii_stl_loops(text: str, source: str) -> list[tuple[str, list]]:
             xyz = [_float(t) for t in tokens[1:]]
             if current is None or len(xyz) != 3 or None in xyz:
                 raise PatternError(f"{where}: expected 'vertex x y z' inside "
-                                   f"'outer loop', got {' '.join(tokens)!r}")
+                                   f"'outer loop', got {_short(' '.join(tokens))}")
             current[1].append(xyz)
         elif word == "endloop" and current is not None:
             loops.append(current)
@@ -286,7 +286,7 @@ def parse_hinges(text: str, source: str, n_edges: int) -> dict[int, tuple]:
 def _hinge_line(tokens: list[str], n_edges: int, where: str) -> tuple:
     if len(tokens) < 3:
         raise PatternError(f"{where}: expected 'edge_id width M|V [bend_angle_deg]', "
-                           f"got {' '.join(tokens)!r}")
+                           f"got {_short(' '.join(tokens))}")
     edge = _int(tokens[0])
     if edge is None or not 0 <= edge < n_edges:
         raise PatternError(f"{where}: edge id {tokens[0]!r} is not an edge of the mesh "
