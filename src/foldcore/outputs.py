@@ -35,10 +35,11 @@ def _iteration_cost(result) -> dict:
             if t["bare_solve"] > 0 else None}
 
 
-def report_dict(result, pattern, mesh, settings: dict) -> dict:
+def report_dict(result, pattern, mesh, settings: dict, quantities: dict | None = None) -> dict:
     """The JSON report of a run (contract in DESIGN.md), plus the settings used.
 
-    Angles in degrees (valley > 0), lengths mm, times seconds.
+    Angles in degrees (valley > 0), lengths mm, times seconds. ``quantities``
+    (a scene's own measurements) go under the key ``quantities``.
     """
     import numba
 
@@ -60,6 +61,7 @@ def report_dict(result, pattern, mesh, settings: dict) -> dict:
         "timings_s": {k: float(v) for k, v in result.timings_s.items()},
         **_iteration_cost(result),
         "settings": settings,
+        **({"quantities": quantities} if quantities else {}),
         "machine": {"python": platform.python_version(), "numba": numba.__version__,
                     "numba_threads": numba.get_num_threads(),
                     "cholmod": cholmod_available()},
@@ -76,7 +78,7 @@ def write_report(path, report: dict) -> None:
 
 
 def write_result(result, pattern, mesh, thickness: float, settings: dict, *, fold=None,
-                 report=None, png=None) -> None:
+                 report=None, png=None, quantities: dict | None = None) -> None:
     """Write the outputs asked for: FOLD (achieved angles + folded solid), JSON report, PNG.
 
     Parameters
@@ -88,6 +90,8 @@ def write_result(result, pattern, mesh, thickness: float, settings: dict, *, fol
     fold, report, png : path or None
         Each file is written atomically; None skips it (and, for ``png``,
         the pyvista import).
+    quantities : dict, optional
+        A scene's own measurements, stored in the report.
     """
     if png:
         from .render import render_png
@@ -97,4 +101,4 @@ def write_result(result, pattern, mesh, thickness: float, settings: dict, *, fol
         write_fold(fold, pattern, achieved_angles=result.fold_angles_deg,
                    frames=[folded_frame(mesh, result.positions)], thickness=thickness)
     if report:
-        write_report(report, report_dict(result, pattern, mesh, settings))
+        write_report(report, report_dict(result, pattern, mesh, settings, quantities))

@@ -1,0 +1,88 @@
+"""The paper's scenes (../SCENES.md): each builds its pattern, folds it, and measures
+the quantities the paper reports, beside the closed forms where they exist.
+
+>>> from foldcore import scenes
+>>> run = scenes.run("d4v", quick=True)          # doctest: +SKIP
+>>> run.quantities["flat"]["fold_angles_deg"]     # doctest: +SKIP
+
+Every scene module defines ``run(quick=False, solver=None) -> SceneRun``;
+``quick`` lowers iteration budgets for tests, never the geometry. Which
+scenes exist is known without importing them (``NAMES``), so the CLI's
+``--help`` and this package stay light.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from importlib import import_module
+
+from ..errors import FoldcoreError
+
+NAMES = {
+    "d4v": "Pehrson's flat-foldable degree-4 vertex, intermediate and flat states",
+    "waterbomb": "6-crease waterbomb base, its two stable positions (paper Table 1)",
+    "miura": "Miura-ori sheet on its rigid-folding path",
+    "hinge-study": "one hinge folded 180°: bend radius and angle error vs subdivisions",
+}
+
+
+@dataclass
+class SceneRun:
+    """What a scene produced.
+
+    Attributes
+    ----------
+    name : str
+    pattern : CreasePattern
+        The pattern as last actuated.
+    mesh : ThickMesh
+    thickness : float, mm
+    result : Result
+        The final state (what FOLD/PNG outputs show).
+    quantities : dict
+        The scene's own measurements (JSON-ready; angles in degrees, lengths mm).
+    settings : dict
+        Solver, tolerances and budgets used (JSON-ready).
+    """
+
+    name: str
+    pattern: object
+    mesh: object
+    thickness: float
+    result: object
+    quantities: dict = field(default_factory=dict)
+    settings: dict = field(default_factory=dict)
+
+
+def run(name: str, quick: bool = False, solver: str | None = None) -> SceneRun:
+    """Run scene ``name`` (see ``NAMES``).
+
+    Parameters
+    ----------
+    quick : bool
+        Lower iteration budgets (tests); the geometry is unchanged.
+    solver : str, optional
+        Strategy (``foldcore.strategies.SOLVERS``); default: the scene's own.
+    """
+    if name not in NAMES:
+        raise FoldcoreError(f"unknown scene {name!r} (available: {', '.join(NAMES)})")
+    module = import_module(f"{__name__}.{name.replace('-', '_')}")
+    return module.run(quick=quick, solver=solver)
+
+
+def write(scene: SceneRun, out, png: bool = True) -> list:
+    """Write ``NAME.fold``, ``NAME.json`` (report + quantities) and ``NAME.png`` to ``out``.
+
+    Returns the paths written. The PNG needs the ``render`` extra (pyvista).
+    """
+    from pathlib import Path
+
+    from ..outputs import write_result
+
+    folder = Path(out)
+    folder.mkdir(parents=True, exist_ok=True)
+    base = folder / scene.name
+    paths = {"fold": base.with_suffix(".fold"), "report": base.with_suffix(".json"),
+             "png": base.with_suffix(".png") if png else None}
+    write_result(scene.result, scene.pattern, scene.mesh, scene.thickness,
+                 {"scene": scene.name, **scene.settings}, quantities=scene.quantities, **paths)
+    return [p for p in paths.values() if p is not None]

@@ -1,0 +1,104 @@
+"""The paper's scenes at reduced budgets, checked against physics.
+
+Tolerances and why:
+
+* M/V: a passive crease may not fold against its assignment; the panels'
+  measured angle may cross 0 by no more than 0.1° (rounding of a state the
+  strips hold at their bound).
+* d4v: in mode A of a flat-foldable vertex ρ1 = ρ3 and ρ2 = −ρ4 exactly at
+  zero thickness; the hinge widths (16, 4, 8, 4 mm on R = 76.2 mm) break the
+  symmetry at first order in ΔW/R, so the pairs may differ by at most
+  degrees(8/76.2) = 6.0°.
+* waterbomb: the symmetric base is compatible (every hinge axis meets the
+  symmetry axis), so the passive family follows the closed form to the
+  solver's accuracy, 0.01°.
+* miura: all creases driven to the zero-thickness angles; the hinge axes sit
+  O(W) off the crease lines, so the angles may differ at first order in
+  W/a: degrees(2/20) = 5.7°, and the corner distances by ≤ (n−1)·W.
+* hinge-study: an exact-arc target is compatible, so its inner face is the
+  Eq. 7 circle to rounding (1e-6 mm); Eq. 8's polygonal inner face
+  approaches it as k grows.
+"""
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from foldcore import scenes
+from foldcore.errors import FoldcoreError
+
+SIGN_SLACK_DEG = 0.1
+
+
+@pytest.fixture(scope="module")
+def runs():
+    return {name: scenes.run(name, quick=True) for name in scenes.NAMES}
+
+
+def respects_assignment(pattern, angles) -> bool:
+    kinds = pattern.assignments[: len(angles)]
+    return bool(np.all(angles[kinds == "V"] >= -SIGN_SLACK_DEG)
+                and np.all(angles[kinds == "M"] <= SIGN_SLACK_DEG))
+
+
+def test_d4v_folds_further_and_keeps_mode_a(runs):
+    q = runs["d4v"].quantities
+    pattern = runs["d4v"].pattern
+    for state in ("intermediate", "flat"):
+        angles = np.array(q[state]["fold_angles_deg"])
+        assert respects_assignment(pattern, angles)
+        assert abs(angles[0] - angles[2]) <= np.degrees(8.0 / 76.2)
+        assert abs(angles[1] + angles[3]) <= np.degrees(8.0 / 76.2)
+    assert q["flat"]["fold_angles_deg"][0] > q["intermediate"]["fold_angles_deg"][0]
+    assert q["flat"]["stack_height_mm"] > runs["d4v"].thickness
+
+
+def test_waterbomb_swaps_major_and_minor_and_follows_the_closed_form(runs):
+    q = runs["waterbomb"].quantities
+    one, two = q["position_1"], q["position_2"]
+    assert one["theta_m_deg"] < 0 < one["theta_v_deg"]
+    assert two["theta_m_deg"] < 0 < two["theta_v_deg"]
+    assert abs(one["theta_m_deg"]) > abs(one["theta_v_deg"])
+    assert abs(two["theta_v_deg"]) > abs(two["theta_m_deg"])
+    assert abs(one["theta_v_deg"] - one["closed_form_minor_deg"]) < 0.01
+    assert abs(-two["theta_m_deg"] - two["closed_form_minor_deg"]) < 0.01
+
+
+def test_miura_follows_its_rigid_folding_path(runs):
+    run = runs["miura"]
+    q = run.quantities
+    assert respects_assignment(run.pattern, run.result.fold_angles_deg)
+    for family in ("zigzag", "straight"):
+        assert q[family]["max_deviation_deg"] <= np.degrees(2.0 / 20.0)
+    extent = q["extent_mm"]
+    slack = (4 - 1) * 2.0
+    assert abs(extent["corner_panels_x"] - extent["closed_form_x"]) <= slack
+    assert abs(extent["corner_panels_y"] - extent["closed_form_y"]) <= slack
+
+
+def test_hinge_study_radius(runs):
+    rows = runs["hinge-study"].quantities["runs"]
+    for row in rows:
+        if row["target"] == "exact arc":
+            assert row["angle_error_deg"] < 0.01
+            assert abs(row["inner_radius_mm"] - row["eq7_inner_radius_mm"]) < 1e-6
+    eq8 = {row["subdivisions"]: row for row in rows
+           if row["target"] == "Eq. 8" and row["width_mm"] == 1.0}
+    gap = {k: abs(r["inner_radius_mm"] - r["eq7_inner_radius_mm"])
+           for k, r in eq8.items() if r["inner_radius_mm"] is not None}
+    assert gap[8] < gap[4]
+
+
+def test_scene_outputs_hold_the_quantities(runs, tmp_path):
+    written = scenes.write(runs["waterbomb"], tmp_path, png=False)
+    assert {p.suffix for p in written} == {".fold", ".json"}
+    report = json.loads((tmp_path / "waterbomb.json").read_text())
+    assert report["quantities"]["position_1"]["table_1"]["prototype"] == [-82.0, 32.0]
+    assert report["settings"]["scene"] == "waterbomb"
+
+
+def test_unknown_scene_is_refused_with_the_list():
+    with pytest.raises(FoldcoreError, match="unknown scene 'box'.*d4v"):
+        scenes.run("box")
