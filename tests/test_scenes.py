@@ -102,3 +102,12 @@ def test_scene_outputs_hold_the_quantities(runs, tmp_path):
 def test_unknown_scene_is_refused_with_the_list():
     with pytest.raises(FoldcoreError, match="unknown scene 'box'.*d4v"):
         scenes.run("box")
+
+
+def test_demo_main_job_writes_each_scene(tmp_path, capsys):
+    from foldcore.demo import main
+
+    assert main(["--out", str(tmp_path), "--scene", "waterbomb"]) == 0
+    assert {p.name for p in tmp_path.iterdir()} == {"waterbomb.fold", "waterbomb.json",
+                                                     "waterbomb.png"}
+    assert "θm/θv -82.0/22.9" in capsys.readouterr().out
