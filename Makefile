@@ -20,10 +20,10 @@ $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
 	@if ./.ci/system-deps --check; then \
-	    $(PY) -m pip install --quiet -e ".[cholmod,render,dev]"; \
+	    $(PY) -m pip install --quiet -e ".[cholmod,render,export,dev]"; \
 	else \
 	    echo "foldcore: SuiteSparse headers missing: installing without CHOLMOD (SciPy fallback)"; \
-	    $(PY) -m pip install --quiet -e ".[render,dev]"; \
+	    $(PY) -m pip install --quiet -e ".[render,export,dev]"; \
 	fi
 	touch $(STAMP)
 

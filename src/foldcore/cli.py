@@ -1,4 +1,13 @@
-"""Command line: ``foldcore simulate PATTERN [options]``.
+"""Command line: ``foldcore simulate PATTERN [options]``, ``foldcore render RESULT.fold -o
+OUT.png [options]``, ``foldcore export RESULT.fold --svg/--dxf/--stl OUT``.
+
+``simulate --animate OUT.gif|OUT.mp4`` also folds the pattern from 0 to
+``--fold-percent`` in ``--frames`` steps (each continuing the previous state)
+and encodes the rendered frames (:mod:`foldcore.animate`); the outputs of the
+run are those of the last frame. ``render`` and ``export`` read a FOLD written
+by ``simulate -o`` and rebuild its thick mesh (:func:`foldcore.fabrication.
+read_result`); pass them the ``--hinge-width``/``--subdivisions`` given to
+``simulate`` when these cannot be recovered from the file.
 
 Exit codes: 0 success (stopping at --max-iterations without convergence is a
 result: exit 0, ``converged: false`` and a warning line on stderr); 2 bad input,
@@ -44,6 +53,41 @@ def _positive(text: str) -> float:
     return value
 
 
+def _size(text: str) -> tuple[int, int]:
+    from .render import RenderError, parse_size
+
+    try:
+        return parse_size(text)
+    except RenderError as exc:
+        raise argparse.ArgumentTypeError(str(exc))
+
+
+def _frames(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected an integer ≥ 2, got {text!r}")
+    if not 2 <= value <= 10_000:
+        raise argparse.ArgumentTypeError(f"expected an integer in 2..10000, got {value}")
+    return value
+
+
+def _fps(text: str) -> float:
+    value = _positive(text)
+    if value > 100:
+        raise argparse.ArgumentTypeError(f"expected frames per second in (0, 100], got {text}")
+    return value
+
+
+def _add_rebuild_options(parser) -> None:
+    """Options of render/export that rebuild the thick mesh of a result file."""
+    parser.add_argument("--hinge-width", type=_positive,
+                        help="hinge width W in mm given to simulate (default: the file's widths)")
+    parser.add_argument("--subdivisions", type=_subdivisions, default=None,
+                        help="sub-strips per hinge given to simulate (default: found from "
+                             "the folded frame)")
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="foldcore", description="Thick-origami simulation.")
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
@@ -75,6 +119,32 @@ def build_parser() -> argparse.ArgumentParser:
     sim.add_argument("--report", help="write the JSON report here")
     sim.add_argument("--render", help="write an offscreen PNG render of the folded solid "
                                       "(needs the 'render' extra: pyvista)")
+    sim.add_argument("--animate", metavar="OUT.gif|OUT.mp4",
+                     help="also write an animation of the fold from 0 to --fold-percent "
+                          "(needs the 'render' extra; MP4 the 'video' extra: imageio-ffmpeg)")
+    sim.add_argument("--frames", type=_frames, default=20,
+                     help="animation frames, fold percents evenly from 0 (default 20)")
+    sim.add_argument("--fps", type=_fps, default=10.0,
+                     help="animation frames per second (default 10)")
+
+    ren = sub.add_parser("render", help="render a result FOLD (simulate -o) to PNG")
+    ren.add_argument("result", help="FOLD file written by foldcore simulate -o")
+    ren.add_argument("-o", "--output", required=True, help="PNG to write")
+    ren.add_argument("--view", default="iso", choices=("iso", "top", "side", "front"),
+                     help="camera: iso (default), top, side (from +x), front (from -y)")
+    ren.add_argument("--size", type=_size, default=(1024, 768),
+                     help="picture size WIDTHxHEIGHT in pixels (default 1024x768)")
+    ren.add_argument("--color-by", default="none", choices=("angle", "strip-angle", "none"),
+                     help="hinge colours: mountain/valley (none, default), each crease's fold "
+                          "angle (angle) or each sub-strip's bend angle (strip-angle), degrees")
+    _add_rebuild_options(ren)
+
+    exp = sub.add_parser("export", help="fabrication files of a result FOLD (simulate -o)")
+    exp.add_argument("result", help="FOLD file written by foldcore simulate -o")
+    exp.add_argument("--svg", help="flat sheet outlines as SVG (mm)")
+    exp.add_argument("--dxf", help="flat sheet outlines as DXF (mm; needs the 'export' extra)")
+    exp.add_argument("--stl", help="folded solid as binary STL (mm)")
+    _add_rebuild_options(exp)
     return parser
 
 
@@ -104,11 +174,17 @@ def simulate(args) -> int:
     if thickness is None:
         raise SimulationError(f"{args.pattern}: no thickness: pass --thickness H (mm) "
                               "or set foldcore:thickness in the file")
+    if args.animate:
+        from .animate import check_output
+        check_output(args.animate)          # a missing encoder fails before any work
     mesh = thicken(pattern, thickness, args.hinge_width, args.subdivisions,
                    exact_arc=not args.eq8)
     sim = Simulation(mesh, pattern, solver=args.solver)
-    sim.set_fold_percent(args.fold_percent)
-    result = sim.run(tolerance=args.tolerance, max_iterations=args.max_iterations)
+    if args.animate:
+        result = _animate(args, sim)
+    else:
+        sim.set_fold_percent(args.fold_percent)
+        result = sim.run(tolerance=args.tolerance, max_iterations=args.max_iterations)
     if not result.converged:
         print(f"foldcore: warning: not converged after {result.iterations} iterations "
               f"(tolerance {args.tolerance:g}); the result is the last iterate",
@@ -122,6 +198,62 @@ def simulate(args) -> int:
     return 0
 
 
+def _animate(args, sim):
+    """Fold ``sim`` from 0 to --fold-percent in --frames steps, write --animate; last Result."""
+    from .animate import fold_sweep, percent_schedule, render_frames, write_animation
+
+    percents = percent_schedule(args.frames, args.fold_percent)
+    results = fold_sweep(sim, percents, tolerance=args.tolerance,
+                         max_iterations=args.max_iterations)
+    frames = render_frames(sim.pattern, sim.mesh, [r.positions for r in results],
+                           titles=[f"fold {p:.4g} %" for p in percents])
+    unconverged = sum(not r.converged for r in results[:-1])
+    if unconverged:
+        print(f"foldcore: warning: {unconverged} of {len(results) - 1} intermediate animation "
+              "frames not converged", file=sys.stderr)
+    write_animation(args.animate, frames, args.fps)
+    return results[-1]
+
+
+def render_result(args) -> int:
+    """Run ``foldcore render``; raises FoldcoreError on bad input.
+
+    The thick mesh is rebuilt from the file (:func:`foldcore.fabrication.read_result`)
+    rather than the stored surface drawn as it is: the stored faces carry no
+    panel/hinge or mountain/valley information, the rebuilt mesh does, and it
+    is accepted only when its surface equals the stored one.
+    """
+    from .fabrication import read_result
+    from .measure import fold_angles
+    from .render import colour_limits, render_png, strip_bend_angles
+
+    res = read_result(args.result, args.hinge_width, args.subdivisions)
+    options = {}
+    if args.color_by != "none":   # signed angles, valley > 0: blue, mountain < 0: red
+        angle = args.color_by == "angle"
+        values = fold_angles(res.pattern, res.mesh, res.positions) if angle \
+            else strip_bend_angles(res.mesh, res.positions)
+        options = dict(scalars=values, clim=colour_limits(values, signed=True), cmap="RdBu",
+                       scalar_name="fold angle (deg)" if angle else "strip bend (deg)")
+    render_png(res.pattern, res.mesh, res.positions, args.output, size=args.size,
+               view=args.view, **options)
+    return 0
+
+
+def export_result(args) -> int:
+    """Run ``foldcore export``; raises FoldcoreError on bad input."""
+    from .fabrication import ExportError, export, read_result
+
+    if not (args.svg or args.dxf or args.stl):
+        raise ExportError(f"{args.result}: nothing to export: give --svg, --dxf and/or --stl")
+    export(read_result(args.result, args.hinge_width, args.subdivisions),
+           svg=args.svg, dxf=args.dxf, stl=args.stl)
+    return 0
+
+
+COMMANDS = {"simulate": simulate, "render": render_result, "export": export_result}
+
+
 def main(argv=None) -> int:
     """Entry point of the ``foldcore`` command; returns the exit code."""
     from .errors import FoldcoreError
@@ -133,11 +265,11 @@ def main(argv=None) -> int:
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("default")
-            return simulate(args)
+            return COMMANDS[args.command](args)
     except FoldcoreError as exc:
         print(f"foldcore: error: {exc}", file=sys.stderr)
     except OSError as exc:
-        name = exc.filename or args.pattern
+        name = exc.filename or getattr(args, "pattern", None) or getattr(args, "result", "")
         print(f"foldcore: error: {name}: {exc.strerror or exc}", file=sys.stderr)
     return EXIT_BAD_INPUT
 

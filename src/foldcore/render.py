@@ -1,7 +1,33 @@
-"""Offscreen PNG renders of a folded thick mesh (pyvista, imported only here).
+"""Offscreen renders of a folded thick mesh (pyvista, imported only inside functions).
 
-Panels are drawn light grey; hinge sub-strips are coloured by their crease's
-assignment: valley blue, mountain red, other creases amber.
+What a picture shows
+--------------------
+* Only the outer surface of the prism mesh (a face shared by two prisms is
+  inside the solid and is not drawn), with polygon edges, so the sub-strips of
+  every hinge stay visible.
+* Panels light grey; hinge sub-strips coloured by their crease's assignment:
+  valley blue, mountain red, unassigned amber, flat grey, with a legend.
+* Or, with ``scalars``, hinge sub-strips coloured by one value per sub-strip
+  or per crease (fold angle in degrees, strain, …) through a colour map, with
+  a labelled colour bar; panels stay grey. Signed values get the diverging map
+  ``RdBu`` with symmetric limits, so valleys (> 0) are blue and mountains red
+  as in the assignment colours.
+
+Cameras
+-------
+Orthographic (parallel projection; true lengths in the top/front/side views),
+looking at the solid from:
+
+* ``iso``: +x +y +z (isometric), z up;
+* ``top``: +z, looking down, x right, y up;
+* ``front``: −y, looking along +y, x right, z up;
+* ``side``: +x, looking along −x, y right, z up;
+* or any (3,) direction vector (from the solid toward the camera).
+
+The camera is fitted to the solid (``fit=True``, default): the projected
+bounding box fills the free part of the picture (the colour bar, legend and
+title strips are kept clear) with ``padding`` around it. ``fit_points`` fits
+to other points instead (an animation fits once to every frame).
 """
 from __future__ import annotations
 
@@ -9,58 +35,445 @@ import os
 
 import numpy as np
 
+from .errors import FoldcoreError
+
 HINGE_COLOURS = {"V": (0.20, 0.40, 0.85), "M": (0.85, 0.25, 0.20),
                  "U": (0.95, 0.65, 0.10), "F": (0.60, 0.60, 0.60)}
+HINGE_LABELS = {"V": "valley", "M": "mountain", "U": "unassigned", "F": "flat"}
 PANEL_COLOUR = (0.88, 0.88, 0.86)
+EDGE_COLOUR = (0.12, 0.12, 0.12)
+BACKGROUND = "white"
+#: Camera direction (solid → camera) and view-up of each preset.
+VIEWS = {"iso": ((1.0, 1.0, 1.0), (0.0, 0.0, 1.0)),
+         "top": ((0.0, 0.0, 1.0), (0.0, 1.0, 0.0)),
+         "front": ((0.0, -1.0, 0.0), (0.0, 0.0, 1.0)),
+         "side": ((1.0, 0.0, 0.0), (0.0, 0.0, 1.0))}
+MAX_SIZE_PX = 8192
+#: Picture strips (fractions of its height/width) kept clear of the solid.
+_BAR_STRIP = 0.20      # bottom: horizontal colour bar
 
 
-def _element_surface(group, chosen, positions):
-    """PolyData of the prisms ``chosen`` (element indices) of a group at ``positions``."""
-    import pyvista as pv
-
-    faces = []
-    for i in chosen:
-        ids = group.indices[group.slots(i)]
-        n = len(ids) // 2
-        top, bot = ids[:n], ids[n:]
-        faces += [np.r_[n, top], np.r_[n, bot[::-1]]]
-        faces += [np.r_[4, top[(j + 1) % n], top[j], bot[j], bot[(j + 1) % n]] for j in range(n)]
-    return pv.PolyData(np.asarray(positions), np.concatenate(faces))
+class RenderError(FoldcoreError, ValueError):
+    """A render was asked with bad options (size, view, scalars) or without pyvista."""
 
 
-def render_png(pattern, mesh, positions, path, size=(1024, 768), view="iso") -> None:
-    """Render the thick mesh at ``positions`` (N, 3) mm to a PNG file, offscreen.
+# ---------------------------------------------------------------- options
+def parse_size(text: str) -> tuple[int, int]:
+    """``"WIDTHxHEIGHT"`` (pixels, e.g. ``"1200x900"``) → ``(width, height)``.
+
+    Raises
+    ------
+    RenderError
+        Not two integers in 16..8192 joined by ``x``.
+    """
+    parts = str(text).lower().split("x")
+    try:
+        size = tuple(int(p) for p in parts)
+    except ValueError:
+        size = ()
+    if len(size) != 2:
+        raise RenderError(f"size must be WIDTHxHEIGHT in pixels (e.g. 1200x900), got {text!r}")
+    return check_size(size)
+
+
+def check_size(size) -> tuple[int, int]:
+    """``(width, height)`` in pixels as ints, each in 16..``MAX_SIZE_PX``."""
+    try:
+        w, h = (int(v) for v in size)
+        ok = all(float(v) == int(v) for v in size)
+    except (TypeError, ValueError):
+        raise RenderError(f"size must be (width, height) in pixels, got {size!r}") from None
+    if not ok or not (16 <= w <= MAX_SIZE_PX and 16 <= h <= MAX_SIZE_PX):
+        raise RenderError(f"size must be two whole numbers of pixels in 16..{MAX_SIZE_PX}, "
+                          f"got {w}x{h}")
+    return w, h
+
+
+def view_vectors(view) -> tuple[np.ndarray, np.ndarray]:
+    """Unit camera direction (solid → camera) and view-up of a preset or a (3,) vector."""
+    if isinstance(view, str):
+        if view not in VIEWS:
+            raise RenderError(f"unknown view {view!r} (available: {', '.join(VIEWS)})")
+        direction, up = (np.array(v, dtype=float) for v in VIEWS[view])
+    else:
+        direction = np.asarray(view, dtype=float)
+        if direction.shape != (3,) or not np.isfinite(direction).all() or \
+                not np.linalg.norm(direction) > 0:
+            raise RenderError(f"view must be one of {', '.join(VIEWS)} or a nonzero 3-vector, "
+                              f"got {view!r}")
+        up = np.array([0.0, 0.0, 1.0])
+        if np.linalg.norm(np.cross(direction, up)) < 1e-6 * np.linalg.norm(direction):
+            up = np.array([0.0, 1.0, 0.0])   # looking along z: y up, as "top"
+    direction = direction / np.linalg.norm(direction)
+    up = up - (up @ direction) * direction
+    return direction, up / np.linalg.norm(up)
+
+
+# ---------------------------------------------------------------- scalars
+def hinge_values(pattern, mesh, scalars) -> np.ndarray:
+    """One value per hinge sub-strip, (S,) float, from per-strip or per-crease values.
 
     Parameters
     ----------
-    view : {"iso", "top", "side"}
-        Camera preset.
+    scalars : (S,) or (E,) array_like
+        S = number of hinge sub-strips (``len(mesh.groups["bending_hinge"])``,
+        e.g. ``Result.strip_angles_deg``), E = number of pattern edges (e.g.
+        ``Result.fold_angles_deg``); per-crease values are repeated on the
+        crease's sub-strips. When S == E the values are taken per strip.
     """
-    pv = _pyvista()
-    plotter = pv.Plotter(off_screen=True, window_size=list(size))
-    plotter.set_background("white")
-    panels = mesh.groups[mesh.panel_group]
-    plotter.add_mesh(_element_surface(panels, range(len(panels)), positions),
-                     color=PANEL_COLOUR,
-                     show_edges=True, edge_color=(0.35, 0.35, 0.35), line_width=1)
     hinges = mesh.groups.get("bending_hinge")
-    if hinges is not None and len(hinges):
-        kinds = pattern.assignments[hinges.source]
-        for kind, colour in HINGE_COLOURS.items():
-            chosen = np.flatnonzero(kinds == kind)
-            if len(chosen):
-                plotter.add_mesh(_element_surface(hinges, chosen, positions), color=colour,
-                                 show_edges=True, edge_color=(0.2, 0.2, 0.2), line_width=1)
-    getattr(plotter, {"iso": "view_isometric", "top": "view_xy", "side": "view_xz"}[view])()
-    folder, name = os.path.split(os.path.abspath(os.fspath(path)))
-    tmp = os.path.join(folder, f".{name}.{os.getpid()}.tmp.png")  # no half-written PNG
-    try:
-        plotter.screenshot(tmp)
-        os.replace(tmp, path)
-    finally:
-        plotter.close()
-        if os.path.exists(tmp):
-            os.unlink(tmp)
+    n_strips = 0 if hinges is None else len(hinges)
+    values = np.asarray(scalars, dtype=float).ravel()
+    if values.shape == (n_strips,):
+        return values.copy()
+    if values.shape == (pattern.n_edges,) and hinges is not None:
+        return values[hinges.source]
+    raise RenderError(f"scalars must have one value per hinge sub-strip ({n_strips}) or per "
+                      f"pattern edge ({pattern.n_edges}), got {values.size}")
+
+
+def colour_limits(values, signed: bool | None = None) -> tuple[float, float]:
+    """Colour-map limits of the finite ``values``.
+
+    ``signed`` True (angles: valley > 0, mountain < 0) gives ±max|v|, so 0
+    is the middle of a diverging map; False gives (0, max) for values ≥ 0,
+    else (min, max); None (default) is True when any value is < 0.
+    """
+    v = np.asarray(values, dtype=float)
+    v = v[np.isfinite(v)]
+    if not len(v):
+        return -1.0, 1.0
+    if signed is None:
+        signed = bool(v.min() < 0)
+    top = float(np.abs(v).max())
+    if signed:
+        return (-top, top) if top > 0 else (-1.0, 1.0)
+    lo, hi = min(0.0, float(v.min())), float(v.max())
+    return (lo, hi) if hi > lo else (lo, lo + 1.0)
+
+
+def default_cmap(clim) -> str:
+    """``RdBu`` (valley blue, mountain red) for signed limits, else ``viridis``."""
+    return "RdBu" if clim[0] < 0 < clim[1] else "viridis"
+
+
+def strip_bend_angles(mesh, positions) -> np.ndarray:
+    """Bend angle of every hinge sub-strip measured on the solid, (S,) degrees, valley > 0.
+
+    The angle between the planes of a sub-strip's two long side faces (the
+    faces across the sheet at its two lines), signed about the crease
+    direction. Rest: 0. The angles of a crease's sub-strips add up to its
+    fold angle when the panels are flat.
+
+    Parameters
+    ----------
+    mesh : ThickMesh
+    positions : (N, 3) float, mm
+    """
+    hinges = mesh.groups.get("bending_hinge")
+    if hinges is None or not len(hinges):
+        return np.zeros(0)
+    x = np.asarray(positions, dtype=float)
+    ids = hinges.indices.reshape(len(hinges), 8)   # top a_j, a_j+1, b_j+1, b_j; bottom same
+    top, bot = x[ids[:, :4]], x[ids[:, 4:]]
+    mid = 0.5 * (top + bot)
+    thick = top - bot
+    # side j: points 0 (a) and 3 (b); side j+1: points 1 (a) and 2 (b)
+    along_j, along_k = mid[:, 3] - mid[:, 0], mid[:, 2] - mid[:, 1]
+    n_j = np.cross(thick[:, 0] + thick[:, 3], along_j)
+    n_k = np.cross(thick[:, 1] + thick[:, 2], along_k)
+    axis = along_j + along_k
+    axis /= np.linalg.norm(axis, axis=1)[:, None]
+    sin = np.einsum("ij,ij->i", np.cross(n_j, n_k), axis)
+    return np.degrees(np.arctan2(-sin, np.einsum("ij,ij->i", n_j, n_k)))
+
+
+# ---------------------------------------------------------------- geometry
+def _surface_polydata(mesh, positions):
+    """Outer surface as PolyData sharing ``positions``: panels, hinges, edge lines.
+
+    Faces are triangulated on the flat footprint (:func:`foldcore.fabrication.
+    surface_triangles`: no slivers at the collinear points panels share with
+    strips) and their polygon edges drawn as lines. The hinge PolyData carries
+    cell data ``strip`` (hinge element index) for per-strip values.
+    """
+    import pyvista as pv
+
+    from .fabrication import surface_edges, surface_polygons, surface_triangles
+
+    surf = surface_polygons(mesh)
+    tris, face = surface_triangles(mesh, surf, return_faces=True)
+    x = np.asarray(positions, dtype=float)
+    out = []
+    for is_hinge in (False, True):
+        chosen = np.flatnonzero(surf.is_hinge[face] == is_hinge)
+        if not len(chosen):
+            out.append(None)
+            continue
+        poly = pv.PolyData(x.copy(), np.column_stack([np.full(len(chosen), 3),
+                                                      tris[chosen]]).ravel())
+        poly.cell_data["strip"] = surf.element[face[chosen]]
+        out.append(poly)
+    edges = surface_edges(surf)
+    lines = pv.PolyData(x.copy(), lines=np.column_stack([np.full(len(edges), 2),
+                                                         edges]).ravel()) if len(edges) else None
+    return out[0], out[1], lines
+
+
+def _behind_lines(actor) -> None:
+    """Push an actor's polygons back in depth so edge lines on them stay visible."""
+    mapper = actor.GetMapper()
+    mapper.SetResolveCoincidentTopologyToPolygonOffset()
+    mapper.SetRelativeCoincidentTopologyPolygonOffsetParameters(2.0, 2.0)
+
+
+def _fit_camera(camera, points, direction, up, aspect, box, padding) -> None:
+    """Orthographic camera looking along −direction, fitting ``points`` into ``box``.
+
+    ``box`` = (x0, x1, y0, y1), the free part of the picture in normalised
+    coordinates; ``aspect`` = width / height in pixels.
+    """
+    p = np.asarray(points, dtype=float).reshape(-1, 3)
+    right = np.cross(-direction, up)
+    u, v, w = p @ right, p @ up, p @ direction
+    x0, x1, y0, y1 = box
+    half_w = 0.5 * max(np.ptp(u), 1e-9) / (x1 - x0)
+    half_h = 0.5 * max(np.ptp(v), 1e-9) / (y1 - y0)
+    scale = max(half_h, half_w / aspect) * (1.0 + 2.0 * padding)
+    # shift so the solid's projected centre lands on the centre of the free box
+    cu = 0.5 * (u.min() + u.max()) - (0.5 * (x0 + x1) - 0.5) * 2.0 * scale * aspect
+    cv = 0.5 * (v.min() + v.max()) - (0.5 * (y0 + y1) - 0.5) * 2.0 * scale
+    focal = cu * right + cv * up + 0.5 * (w.min() + w.max()) * direction
+    distance = 2.0 * float(np.linalg.norm(p - p.mean(axis=0), axis=1).max()) + 1.0
+    camera.parallel_projection = True
+    camera.focal_point = tuple(focal)
+    camera.position = tuple(focal + distance * direction)
+    camera.up = tuple(up)
+    camera.parallel_scale = scale
+    camera.clipping_range = (1e-3 * distance, 4.0 * distance + np.ptp(w))
+
+
+# ---------------------------------------------------------------- renderer
+class Renderer:
+    """An offscreen picture of one thick mesh; move it and take frames.
+
+    Parameters
+    ----------
+    pattern : CreasePattern
+    mesh : ThickMesh
+    size : (int, int)
+        Width, height in pixels.
+    view : str or (3,) array
+        Camera preset (``iso``, ``top``, ``front``, ``side``) or direction from
+        the solid to the camera; see the module docstring.
+    scalars : (S,) or (E,) array_like, optional
+        Colour hinge sub-strips by these values (see :func:`hinge_values`);
+        None: colour by assignment (M/V) with a legend.
+    scalar_name : str
+        Colour-bar title, with its unit, e.g. ``"fold angle (deg)"``.
+    cmap : str, optional
+        matplotlib colour map; default :func:`default_cmap`.
+    clim : (float, float), optional
+        Colour limits; default :func:`colour_limits` of ``scalars``.
+    legend : bool
+        Show the M/V legend (assignment colouring only).
+    padding : float
+        Margin around the fitted solid, fraction of its extent.
+    title : str, optional
+        Text in the upper-left corner.
+
+    Use as a context manager, or call :meth:`close`.
+    """
+
+    def __init__(self, pattern, mesh, size=(1024, 768), view="iso", *, scalars=None,
+                 scalar_name="value", cmap=None, clim=None, legend=True, padding=0.04,
+                 title=None):
+        self.size = check_size(size)
+        self.direction, self.up = view_vectors(view)
+        self.pattern, self.mesh = pattern, mesh
+        self.padding = float(padding)
+        pv = _pyvista()
+        self.plotter = pv.Plotter(off_screen=True, window_size=list(self.size))
+        self.plotter.set_background(BACKGROUND)
+        self._box = [0.0, 1.0, 0.0, 1.0]
+        self._title = None
+        try:
+            self.panels, self.hinges, self.lines = _surface_polydata(mesh, mesh.rest_positions)
+            self._add_panels()
+            self._add_edges()
+            if scalars is None:
+                self._add_assignment_hinges(legend)
+            else:
+                self._add_scalar_hinges(scalars, scalar_name, cmap, clim)
+            self._add_title(title)
+        except BaseException:
+            self.close()
+            raise
+
+    # -- scene
+    def _add_panels(self):
+        if self.panels is not None:
+            _behind_lines(self.plotter.add_mesh(self.panels, color=PANEL_COLOUR))
+
+    def _add_edges(self):
+        if self.lines is not None:
+            self.plotter.add_mesh(self.lines, color=EDGE_COLOUR, line_width=1)
+
+    def _add_assignment_hinges(self, legend: bool):
+        if self.hinges is None:
+            return
+        group = self.mesh.groups["bending_hinge"]
+        kinds = np.asarray(self.pattern.assignments)[group.source[self.hinges.cell_data["strip"]]]
+        rgb = np.array([HINGE_COLOURS.get(k, HINGE_COLOURS["U"]) for k in kinds])
+        self.hinges.cell_data["colour"] = (255 * rgb).astype(np.uint8)
+        _behind_lines(self.plotter.add_mesh(self.hinges, scalars="colour", rgb=True))
+        present = [k for k in HINGE_COLOURS if k in set(kinds)]
+        if legend and present:
+            entries = [[HINGE_LABELS[k], HINGE_COLOURS[k]] for k in present]
+            entry = max(0.055 * self.size[1], 16.0)     # pixels per legend line
+            width = min(0.5, 4.85 * entry / self.size[0])
+            height = min(0.5, entry * (len(entries) + 0.5) / self.size[1])
+            legend = self.plotter.add_legend(entries, bcolor="white", border=True,
+                                             face="rectangle", loc=None)
+            # placed by hand: pyvista 0.49's "lower right" uses the height for x
+            legend.SetPosition(1.0 - width - 0.02, 0.02)
+            legend.SetPosition2(width, height)
+            self._box[1] = 1.0 - width - 0.02
+
+    def _add_scalar_hinges(self, scalars, name, cmap, clim):
+        strips = hinge_values(self.pattern, self.mesh, scalars)
+        if self.hinges is None:
+            return
+        self.clim = tuple(float(c) for c in (clim or colour_limits(strips)))
+        self.hinges.cell_data["value"] = strips[self.hinges.cell_data["strip"]]
+        bar = dict(title=name, color="black", vertical=False, position_x=0.2,
+                   position_y=0.03, width=0.6, height=0.09, n_labels=5, fmt="%.3g",
+                   title_font_size=self._font(18), label_font_size=self._font(16),
+                   unconstrained_font_size=True)
+        _behind_lines(self.plotter.add_mesh(
+            self.hinges, scalars="value", cmap=cmap or default_cmap(self.clim), clim=self.clim,
+            nan_color=(0.5, 0.5, 0.5), scalar_bar_args=bar))
+        self._box[2] = _BAR_STRIP
+
+    def _add_title(self, title):
+        if title is None:
+            return
+        size = self._font(18)
+        self._title = self.plotter.add_text(str(title), font_size=size, color="black",
+                                            position=(size // 2, self.size[1] - 2 * size))
+        self._title.GetTextProperty().SetFontSize(size)   # pyvista may rescale it
+        self._box[3] = 1.0 - 2.5 * size / self.size[1]
+
+    def _font(self, at_768: int) -> int:
+        """A font size (points) for this picture: ``at_768`` on a 768-px-high one."""
+        return max(10, round(at_768 * min(self.size[1] / 768, self.size[0] / 1024)))
+
+    # -- per frame
+    def update(self, positions, scalars=None, title=None) -> None:
+        """Move the solid to ``positions`` (N, 3) mm; optionally new scalars / title."""
+        x = np.asarray(positions, dtype=float)
+        if x.shape != (self.mesh.n_vertices, 3) or not np.isfinite(x).all():
+            raise RenderError(f"positions must be a finite ({self.mesh.n_vertices}, 3) array "
+                              f"of mm, got shape {x.shape}")
+        for poly in (self.panels, self.hinges, self.lines):
+            if poly is not None:
+                poly.points = x.copy()
+        if scalars is not None and self.hinges is not None and "value" in self.hinges.cell_data:
+            strips = hinge_values(self.pattern, self.mesh, scalars)
+            self.hinges.cell_data["value"] = strips[self.hinges.cell_data["strip"]]
+        if title is not None and self._title is not None:
+            self._title.SetInput(str(title))   # a vtkTextActor: fixed size in pixels
+
+    def fit(self, points=None) -> None:
+        """Fit the camera to ``points`` (M, 3) mm, default the current solid."""
+        if points is None:
+            points = np.vstack([p.points for p in (self.panels, self.hinges) if p is not None])
+        w, h = self.size
+        _fit_camera(self.plotter.camera, points, self.direction, self.up, w / h,
+                    self._box, self.padding)
+
+    def image(self) -> np.ndarray:
+        """The current picture, (height, width, 3) uint8 RGB."""
+        self.plotter.render()
+        return np.asarray(self.plotter.screenshot(None, return_img=True))[..., :3].copy()
+
+    def save(self, path) -> None:
+        """Write the current picture as PNG at ``path``, atomically."""
+        from .fabrication import atomic_path
+
+        self.plotter.render()
+        with atomic_path(path, suffix=".png") as tmp:
+            self.plotter.screenshot(tmp)
+
+    def close(self) -> None:
+        self.plotter.close()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+
+# ---------------------------------------------------------------- one picture
+def render_image(pattern, mesh, positions, size=(1024, 768), view="iso", *, fit=True,
+                 fit_points=None, **options) -> np.ndarray:
+    """Render the thick mesh at ``positions`` (N, 3) mm; returns (height, width, 3) uint8.
+
+    ``options`` are those of :class:`Renderer` (``scalars``, ``scalar_name``,
+    ``cmap``, ``clim``, ``legend``, ``padding``, ``title``). ``fit=False``
+    keeps pyvista's own camera reset (perspective) for the view direction.
+    """
+    with Renderer(pattern, mesh, size, view, **options) as r:
+        r.update(positions)
+        _place_camera(r, fit, fit_points)
+        return r.image()
+
+
+def render_png(pattern, mesh, positions, path, size=(1024, 768), view="iso", *, fit=True,
+               fit_points=None, **options) -> None:
+    """Render the thick mesh at ``positions`` (N, 3) mm to a PNG file, offscreen, atomically.
+
+    Parameters
+    ----------
+    pattern : CreasePattern
+    mesh : ThickMesh
+    positions : (N, 3) float, mm
+    path : str or os.PathLike
+        The PNG written (appears only when complete).
+    size : (int, int)
+        Width, height in pixels (default 1024×768).
+    view : {"iso", "top", "front", "side"} or (3,) array
+        Camera preset or direction (module docstring).
+    fit : bool
+        Fit the orthographic camera tightly to the solid (default).
+    fit_points : (M, 3) array, optional
+        Fit to these points instead (e.g. every frame of an animation).
+    **options
+        :class:`Renderer` keywords: ``scalars`` (per sub-strip or per crease,
+        e.g. ``result.strip_angles_deg``), ``scalar_name`` (colour-bar title
+        with unit), ``cmap``, ``clim``, ``legend``, ``padding``, ``title``.
+
+    Examples
+    --------
+    >>> render_png(pattern, mesh, result.positions, "fold.png", view="top",
+    ...            scalars=result.strip_angles_deg,
+    ...            scalar_name="strip bend (deg)")          # doctest: +SKIP
+    """
+    with Renderer(pattern, mesh, size, view, **options) as r:
+        r.update(positions)
+        _place_camera(r, fit, fit_points)
+        r.save(path)
+
+
+def _place_camera(r: Renderer, fit: bool, fit_points) -> None:
+    if fit:
+        r.fit(fit_points)
+        return
+    r.plotter.camera.position = tuple(r.direction)
+    r.plotter.camera.focal_point = (0.0, 0.0, 0.0)
+    r.plotter.camera.up = tuple(r.up)
+    r.plotter.reset_camera()
 
 
 def _pyvista():
@@ -68,8 +481,9 @@ def _pyvista():
     if not os.environ.get("DISPLAY"):
         # without this VTK first tries X, fails with a warning, then falls back to EGL
         os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
-    import pyvista as pv
-
+    try:
+        import pyvista as pv
+    except ImportError:
+        raise RenderError("rendering needs pyvista: pip install 'foldcore[render]'") from None
     pv.OFF_SCREEN = True
     return pv
-

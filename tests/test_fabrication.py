@@ -1,0 +1,288 @@
+"""Fabrication files (foldcore.fabrication) and ``foldcore export``.
+
+Every file is read back by an independent library: SVG by an XML parser
+(xml.etree), DXF by ezdxf, STL by trimesh (and its edges counted here).
+
+Volume checks (STL, float32 coordinates):
+
+* rest: enclosed volume = Σ prism volumes (``mesh.volume()``), relative 1e-6;
+* single hinge folded by the rigid strategy (each sub-strip a planar-faced
+  prism bent by φ about the arc's centre): panels keep their volume and each
+  sub-strip's cross-section becomes a trapezoid of area W/k·H·sin φ/φ, so the
+  volume is V_panels + Σ V_strip·sin φ/φ, relative 1e-6;
+* degree-4 vertex folded: the panels keep their volume and no sub-strip can
+  lose more than its chord deficit, so V_panels + V_hinges·sin φmax/φmax −
+  1e-6·V ≤ V ≤ V_rest + 1e-6·V.
+"""
+from __future__ import annotations
+
+import json
+import sys
+import xml.etree.ElementTree as ET
+from functools import lru_cache
+
+import numpy as np
+import pytest
+
+from foldcore import patterns
+from foldcore.cli import main
+from foldcore.fabrication import (ExportError, atomic_path, read_result, sheet_outlines,
+                                  stl_bytes, surface_triangles, triangulate_polygon)
+
+SVG_NS = "{http://www.w3.org/2000/svg}"
+
+
+@lru_cache(maxsize=None)
+def scene(name: str):
+    """(pattern, mesh, result) folded with the rigid strategy (as tests/test_render.py)."""
+    from foldcore.simulation import Simulation
+    from foldcore.thicken import thicken   # not foldcore.thicken: the submodule shadows it
+
+    if name == "hinge":
+        pattern = patterns.single_hinge(panel_length=5.0, depth=4.0, angle=90.0, width=2.0)
+        mesh = thicken(pattern, 1.0, subdivisions=4)
+    else:
+        pattern = patterns.degree4_vertex(radius=20.0, widths=(4.0, 1.0, 2.0, 1.0), rho1=90.0)
+        mesh = thicken(pattern, 1.0)
+    result = Simulation(mesh, pattern, solver="rigid").run(tolerance=1e-10,
+                                                           max_iterations=200)
+    assert result.converged
+    return pattern, mesh, result
+
+
+@pytest.fixture
+def result_fold(tmp_path):
+    """The folded d4 scene written as ``simulate -o`` writes it."""
+    from foldcore.outputs import write_result
+
+    pattern, mesh, result = scene("d4")
+    path = tmp_path / "d4.fold"
+    write_result(result, pattern, mesh, 1.0, {}, fold=path)
+    return path
+
+
+def _area(xy) -> float:
+    xy = np.asarray(xy, dtype=float)
+    return 0.5 * float(np.sum(xy[:, 0] * np.roll(xy[:, 1], -1) - np.roll(xy[:, 0], -1) * xy[:, 1]))
+
+
+# ------------------------------------------------------------------ STL
+def _trimesh_of(data: bytes, tmp_path):
+    trimesh = pytest.importorskip("trimesh")
+    path = tmp_path / "solid.stl"
+    path.write_bytes(data)
+    return trimesh.load(str(path), file_type="stl", process=True)
+
+
+def _check_closed_and_oriented(faces: np.ndarray):
+    """Every edge in exactly two triangles, once in each direction (consistent winding)."""
+    directed = np.vstack([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]])
+    undirected, counts = np.unique(np.sort(directed, axis=1), axis=0, return_counts=True)
+    assert (counts == 2).all(), f"{(counts != 2).sum()} edges not shared by two triangles"
+    assert len(np.unique(directed, axis=0)) == len(directed), "an edge used twice one way"
+
+
+@pytest.mark.parametrize("name", ["hinge", "d4"])
+def test_stl_at_rest_is_watertight_with_the_prism_volume(name, tmp_path):
+    _, mesh, _ = scene(name)
+    solid = _trimesh_of(stl_bytes(mesh), tmp_path)
+    assert solid.is_watertight and solid.is_winding_consistent
+    _check_closed_and_oriented(solid.faces)
+    assert solid.volume == pytest.approx(mesh.volume(), rel=1e-6)     # > 0: outward normals
+    assert len(solid.faces) == len(surface_triangles(mesh))
+
+
+def test_folded_hinge_stl_volume_is_panels_plus_chord_trapezoids(tmp_path):
+    _, mesh, result = scene("hinge")
+    solid = _trimesh_of(stl_bytes(mesh, result.positions), tmp_path)
+    assert solid.is_watertight and solid.is_winding_consistent
+    _check_closed_and_oriented(solid.faces)
+    hinges = mesh.groups["bending_hinge"]
+    phi = np.radians(np.abs(result.strip_angles_deg))
+    expected = mesh.groups["rigid_panel"].volumes.sum() + (hinges.volumes * np.sinc(
+        phi / np.pi)).sum()
+    assert solid.volume == pytest.approx(expected, rel=1e-6)
+
+
+def test_folded_vertex_stl_keeps_the_panel_volume(tmp_path):
+    from foldcore.render import strip_bend_angles
+
+    _, mesh, result = scene("d4")
+    solid = _trimesh_of(stl_bytes(mesh, result.positions), tmp_path)
+    assert solid.is_watertight and solid.is_winding_consistent
+    _check_closed_and_oriented(solid.faces)
+    panels = mesh.groups["rigid_panel"].volumes.sum()
+    hinges = mesh.groups["bending_hinge"].volumes.sum()
+    phi = np.radians(np.abs(strip_bend_angles(mesh, result.positions)).max())
+    tol = 1e-6 * mesh.volume()
+    assert panels + hinges * np.sinc(phi / np.pi) - tol <= solid.volume <= mesh.volume() + tol
+
+
+def test_stl_header_is_binary_and_refuses_bad_positions():
+    _, mesh, _ = scene("hinge")
+    data = stl_bytes(mesh)
+    n = int(np.frombuffer(data[80:84], "<u4")[0])
+    assert len(data) == 84 + 50 * n and not data.startswith(b"solid")
+    with pytest.raises(ExportError, match="positions"):
+        stl_bytes(mesh, np.zeros((3, 3)))
+
+
+def test_triangulation_of_a_non_convex_polygon_with_collinear_points():
+    # an L shape, with extra points on two sides (as panels get strip corners)
+    xy = np.array([[0, 0], [1, 0], [2, 0], [2, 1], [1, 1], [1, 2], [1, 3], [0, 3], [0, 1.5]],
+                  dtype=float)
+    for poly in (xy, xy[::-1]):
+        tris = triangulate_polygon(poly)
+        assert tris.shape == (len(poly) - 2, 3)
+        areas = [_area(poly[t]) for t in tris]
+        sign = np.sign(_area(poly))
+        assert all(sign * a > 1e-12 for a in areas)                 # no slivers, one winding
+        assert sum(areas) == pytest.approx(_area(poly))
+
+
+# ------------------------------------------------------------------ outlines
+def test_outlines_cover_the_sheet_with_a_hole_at_the_vertex():
+    _, mesh, _ = scene("d4")
+    out = sheet_outlines(mesh)
+    assert len(out["PANEL"]) == 4 and len(out["HINGE"]) == 4
+    areas = [_area(p) for p in out["CUT"]]
+    assert sum(a > 0 for a in areas) == 1 and sum(a < 0 for a in areas) == 1  # sheet + hole
+    footprint = (mesh.groups["rigid_panel"].volumes.sum() +
+                 mesh.groups["bending_hinge"].volumes.sum()) / mesh.thickness
+    assert sum(areas) == pytest.approx(footprint, rel=1e-9)
+    assert sum(_area(p) for p in out["PANEL"]) == pytest.approx(
+        mesh.groups["rigid_panel"].volumes.sum() / mesh.thickness, rel=1e-9)
+    assert sum(_area(p) for p in out["HINGE"]) == pytest.approx(
+        mesh.groups["bending_hinge"].volumes.sum() / mesh.thickness, rel=1e-9)
+    for loops in out.values():
+        for p in loops:
+            assert len(p) >= 3 and not np.allclose(p[0], p[-1])    # closed, not repeated
+
+
+def _svg_polygons(path):
+    root = ET.parse(path).getroot()
+    assert root.tag == f"{SVG_NS}svg"
+    assert root.get("width").endswith("mm") and root.get("height").endswith("mm")
+    x0, y0, w, h = map(float, root.get("viewBox").split())
+    assert float(root.get("width")[:-2]) == pytest.approx(w)      # 1 user unit = 1 mm
+    layers = {}
+    for group in root.iter(f"{SVG_NS}g"):
+        polys = []
+        for poly in group.iter(f"{SVG_NS}polygon"):
+            pts = np.array([[float(v) for v in pair.split(",")]
+                            for pair in poly.get("points").split()])
+            assert ((pts >= [x0, y0]) & (pts <= [x0 + w, y0 + h])).all()
+            polys.append(pts * [1, -1])                              # back to y up
+        layers[group.get("id").upper()] = polys
+    # only polygons (closed by definition): no open polylines or paths
+    assert not list(root.iter(f"{SVG_NS}polyline")) and not list(root.iter(f"{SVG_NS}path"))
+    return layers
+
+
+def _dxf_polylines(path):
+    ezdxf = pytest.importorskip("ezdxf")
+    doc = ezdxf.readfile(path)
+    assert doc.header["$INSUNITS"] == 4                              # millimetres
+    layers = {}
+    for e in doc.modelspace():
+        assert e.dxftype() == "LWPOLYLINE" and e.closed
+        layers.setdefault(e.dxf.layer, []).append(np.array(e.get_points("xy")))
+    return layers
+
+
+def test_cli_export_writes_svg_dxf_stl_read_back_independently(result_fold, tmp_path):
+    svg, dxf, stl = (tmp_path / f"sheet.{s}" for s in ("svg", "dxf", "stl"))
+    assert main(["export", str(result_fold), "--svg", str(svg), "--dxf", str(dxf),
+                 "--stl", str(stl)]) == 0
+    _, mesh, result = scene("d4")
+    expected = sheet_outlines(mesh)
+    from_svg, from_dxf = _svg_polygons(svg), _dxf_polylines(dxf)
+    for layer, loops in expected.items():
+        assert len(from_svg[layer]) == len(from_dxf[layer]) == len(loops), layer
+        for want, got_svg, got_dxf in zip(loops, from_svg[layer], from_dxf[layer]):
+            assert got_svg == pytest.approx(want, abs=1e-6)
+            assert got_dxf == pytest.approx(want, abs=1e-9)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["d4.fold", "sheet.dxf", "sheet.stl",
+                                                          "sheet.svg"]     # no temp files
+    solid = _trimesh_of(stl.read_bytes(), tmp_path)
+    assert solid.is_watertight
+    assert solid.bounds == pytest.approx(np.array([result.positions.min(axis=0),
+                                                   result.positions.max(axis=0)]), abs=1e-5)
+
+
+def test_cli_export_any_subset(result_fold, tmp_path):
+    stl = tmp_path / "only.stl"
+    assert main(["export", str(result_fold), "--stl", str(stl)]) == 0
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["d4.fold", "only.stl"]
+
+
+def test_read_result_finds_explicit_subdivisions(tmp_path):
+    """simulate --subdivisions 4 leaves no trace in the file; the frame's faces tell."""
+    from foldcore.outputs import write_result
+
+    pattern, mesh, result = scene("hinge")        # k = 4, auto would be 2
+    path = tmp_path / "hinge.fold"
+    write_result(result, pattern, mesh, 1.0, {}, fold=path)
+    res = read_result(path)
+    assert res.mesh.subdivisions.tolist() == mesh.subdivisions.tolist()
+    assert res.positions == pytest.approx(result.positions, abs=1e-12)
+    assert res.footprint_misfit_mm < 1e-9
+
+
+def _bad_export_inputs(result_fold, tmp_path):
+    from foldcore.io import write_fold
+
+    plain = tmp_path / "plain.fold"
+    write_fold(plain, scene("d4")[0], thickness=1.0)
+    edited = json.loads(result_fold.read_text())
+    edited["file_frames"][0]["vertices_coords"] = edited["file_frames"][0]["vertices_coords"][:-1]
+    short = tmp_path / "short.fold"
+    short.write_text(json.dumps(edited))
+    svg, stl = str(tmp_path / "o.svg"), str(tmp_path / "o.stl")
+    fold = str(result_fold)
+    return {
+        "nothing asked": (["export", fold], "nothing to export"),
+        "missing file": (["export", str(tmp_path / "nope.fold"), "--stl", stl], "nope.fold"),
+        "not a result": (["export", str(plain), "--stl", stl], "no folded frame"),
+        "frame mismatch": (["export", str(short), "--stl", stl], "short.fold"),
+        "wrong width": (["export", fold, "--svg", svg, "--hinge-width", "3"], "--hinge-width"),
+        "wrong subdivisions": (["export", fold, "--stl", stl, "--subdivisions", "3"],
+                               "--subdivisions"),
+        "no folder": (["export", fold, "--stl", str(tmp_path / "no" / "o.stl")],
+                      "no such folder"),
+        "bad width": (["export", fold, "--stl", stl, "--hinge-width", "-1"], "--hinge-width"),
+    }
+
+
+def test_cli_export_bad_input_exits_2_with_one_line_and_no_file(result_fold, tmp_path,
+                                                                capsys):
+    cases = _bad_export_inputs(result_fold, tmp_path)
+    for what, (argv, needle) in cases.items():
+        before = set(tmp_path.iterdir())
+        assert main(argv) == 2, what
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and err.startswith("foldcore: error: "), (what, err)
+        assert needle in err and "Traceback" not in err, (what, err)
+        assert set(tmp_path.iterdir()) == before, what
+
+
+def test_missing_ezdxf_fails_before_any_file_is_written(result_fold, tmp_path, monkeypatch,
+                                                       capsys):
+    monkeypatch.setitem(sys.modules, "ezdxf", None)          # as if not installed
+    svg, dxf = tmp_path / "a.svg", tmp_path / "a.dxf"
+    assert main(["export", str(result_fold), "--svg", str(svg), "--dxf", str(dxf)]) == 2
+    assert "ezdxf" in capsys.readouterr().err
+    assert not svg.exists() and not dxf.exists()
+
+
+def test_atomic_path_leaves_nothing_on_error(tmp_path):
+    target = tmp_path / "x.stl"
+    with pytest.raises(RuntimeError):
+        with atomic_path(target) as tmp:
+            open(tmp, "wb").write(b"half")
+            raise RuntimeError("writer failed")
+    assert list(tmp_path.iterdir()) == []
+    with atomic_path(target) as tmp:
+        assert tmp.endswith(".stl")
+        open(tmp, "wb").write(b"whole")
+    assert target.read_bytes() == b"whole" and len(list(tmp_path.iterdir())) == 1
