@@ -26,7 +26,7 @@ from foldcore import patterns
 from foldcore.cli import main
 from foldcore.io import write_fold
 from foldcore.simulation import Simulation
-from foldcore.thicken import thicken
+from foldcore.thickening import thicken
 
 H = 1.0  # mm
 BUDGET = 400

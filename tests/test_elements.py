@@ -28,7 +28,7 @@ import naive
 from elements import _registry
 from foldcore import patterns
 from foldcore.system import gather, vertex_slots
-from foldcore.thicken import thicken
+from foldcore.thickening import thicken
 
 W, H, TARGET, SIGN, MAX_ANGLE, FLOOR, EXACT = range(7)
 TYPES = elements.available()

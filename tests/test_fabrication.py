@@ -36,7 +36,7 @@ SVG_NS = "{http://www.w3.org/2000/svg}"
 def scene(name: str):
     """(pattern, mesh, result) folded with the rigid strategy (as tests/test_render.py)."""
     from foldcore.simulation import Simulation
-    from foldcore.thicken import thicken   # not foldcore.thicken: the submodule shadows it
+    from foldcore.thickening import thicken
 
     if name == "hinge":
         pattern = patterns.single_hinge(panel_length=5.0, depth=4.0, angle=90.0, width=2.0)

@@ -47,7 +47,7 @@ MAX_CHANGED = 0.005       # fraction of pixels allowed to differ by more
 def scene(name: str):
     """(pattern, mesh, result) of a test scene, folded with the rigid strategy."""
     from foldcore.simulation import Simulation
-    from foldcore.thicken import thicken   # not foldcore.thicken: the submodule shadows it
+    from foldcore.thickening import thicken
 
     if name == "hinge":
         pattern = patterns.single_hinge(panel_length=5.0, depth=4.0, angle=90.0, width=2.0)

@@ -16,7 +16,7 @@ import pytest
 
 from foldcore import SimulationError, patterns
 from foldcore.simulation import Simulation
-from foldcore.thicken import thicken
+from foldcore.thickening import thicken
 
 H = 1.0          # mm
 PANEL = 5.0 * H  # panel length from the crease line, mm

@@ -49,3 +49,17 @@ def test_second_process_loads_kernels_from_the_cache():
     _probe(RUN_PROBE)                  # compiles (cold) or loads (warm)
     misses = _probe(RUN_PROBE)         # a new process: nothing may compile
     assert all(n == 0 for n in misses.values()), misses
+
+
+def test_public_names_survive_submodule_imports():
+    """``foldcore.thicken`` stays the function after its submodules are imported
+    (a submodule named like a lazy attribute would replace it)."""
+    import importlib
+    import pkgutil
+
+    import foldcore
+
+    for info in pkgutil.iter_modules(foldcore.__path__):
+        importlib.import_module(f"foldcore.{info.name}")
+    assert callable(foldcore.thicken) and callable(foldcore.read)
+    assert isinstance(foldcore.Simulation, type)

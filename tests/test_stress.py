@@ -33,7 +33,7 @@ from foldcore import patterns
 from foldcore.errors import FoldcoreError, MeshError
 from foldcore.io import read_fold_file
 from foldcore.simulation import Simulation
-from foldcore.thicken import thicken
+from foldcore.thickening import thicken
 
 UNITS = {"mm": 1.0, "m": 1e-3, "um": 1e3}  # factor from mm to the unit
 

@@ -19,7 +19,7 @@ from hypothesis import strategies as st
 from foldcore import patterns
 from foldcore.errors import MeshError
 from foldcore.pattern import CreasePattern
-from foldcore.thicken import auto_subdivisions, minimum_hinge_width, thicken
+from foldcore.thickening import auto_subdivisions, minimum_hinge_width, thicken
 
 REL = 1e-9
 FAST = settings(max_examples=60, deadline=None,

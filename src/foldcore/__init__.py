@@ -20,7 +20,7 @@ __version__ = "0.1.0"
 
 _LAZY = {
     "CreasePattern": ("foldcore.pattern", "CreasePattern"),
-    "thicken": ("foldcore.thicken", "thicken"),
+    "thicken": ("foldcore.thickening", "thicken"),
     "ThickMesh": ("foldcore.mesh", "ThickMesh"),
     "Simulation": ("foldcore.simulation", "Simulation"),
     "Result": ("foldcore.simulation", "Result"),

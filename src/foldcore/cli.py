@@ -165,7 +165,7 @@ def simulate(args) -> int:
     from .errors import SimulationError
     from .outputs import write_result
     from .simulation import Simulation
-    from .thicken import thicken
+    from .thickening import thicken
 
     if args.max_iterations < 1:
         raise SimulationError(f"--max-iterations must be ≥ 1, got {args.max_iterations}")

@@ -539,7 +539,7 @@ def _matching_mesh(pattern, thickness, hinge_width, subdivisions, positions, fac
     """The ThickMesh whose outer faces are ``faces`` (see :func:`read_result`)."""
     from .errors import MeshError
     from .mesh import surface_faces
-    from .thicken import MAX_SUBDIVISIONS, thicken
+    from .thickening import MAX_SUBDIVISIONS, thicken
 
     if subdivisions is not None:
         candidates = [(subdivisions, True)]

@@ -19,7 +19,7 @@ import numpy as np
 from ..kinematics import degree4_deg
 from ..patterns import PEHRSON_SECTORS, degree4_vertex
 from ..simulation import Simulation
-from ..thicken import thicken
+from ..thickening import thicken
 from . import SceneRun
 from ._measure import extent_along, panel_normal, rounded
 

@@ -23,7 +23,7 @@ import numpy as np
 
 from ..patterns import single_hinge
 from ..simulation import Simulation
-from ..thicken import thicken
+from ..thickening import thicken
 from . import SceneRun
 
 THICKNESS = 0.5  # mm

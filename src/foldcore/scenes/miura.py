@@ -26,7 +26,7 @@ import numpy as np
 from ..kinematics import miura_angles_deg, miura_cell
 from ..patterns import miura, miura_edge_kinds
 from ..simulation import Simulation
-from ..thicken import thicken
+from ..thickening import thicken
 from . import SceneRun
 
 N, M = 4, 4  # facets along x and y

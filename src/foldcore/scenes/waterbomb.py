@@ -26,7 +26,7 @@ import numpy as np
 from ..kinematics import waterbomb_minor_deg
 from ..patterns import waterbomb
 from ..simulation import Simulation
-from ..thicken import thicken
+from ..thickening import thicken
 from . import SceneRun
 from ._measure import rounded
 
