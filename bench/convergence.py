@@ -9,17 +9,25 @@ Scenes (H, W, k in mm / count; exact-arc targets):
   (H/R = 1e-3), W = 0.02, k = 4, all four creases actuated to mode A of
   kinematics.md at ρ1 = 60°. Error = max over creases vs the closed form,
   and vs a reference converged with the rigid strategy to a 1e-13 step.
-* ``pehrson_90``: Pehrson's vertex at the paper's dimensions (Ø152.4,
-  H = 3.175, W = 16/4/8/4, k = 4), crease 1 actuated to 90°, the others
-  passive. Error = max over creases vs mode A of the closed form.
+* ``pehrson_90`` / ``pehrson_flat``: Pehrson's vertex at the paper's
+  dimensions (Ø152.4, H = 3.175, W = 16/4/8/4, k = 4), crease 1 actuated to
+  90° / 180°, the others passive. Error = max over creases vs mode A of the
+  closed form.
+* ``waterbomb6_thin``: 6-crease waterbomb, H/R = 1e-3, majors actuated to
+  90°; error vs the closed-form minor angle (kinematics.waterbomb_minor).
+* ``miura{5,20}_{thin,thick}``: Miura n×n, a = b = 20, γ = 60°, H = 0.02
+  (thin, H/a = 1e-3) or 1, W = 2H, k = 2; one interior zig-zag crease
+  actuated to 60°, the rest passive; error = max over all creases vs
+  kinematics.miura_angles at facet tilt 30°.
 
 The rigid strategy stops at a step ≤ 1e-10 × extent; the paper's map runs
 its whole budget (tolerance 0), because its step-size rule stops it early
 on slow scenes (on the thin vertex it "converges" after 40 iterations with
 60° left, measured). Time = the strategy's own time (setup + projection + solve from
 ``Simulation.timings``), so measuring the error in the callback does not
-count. The paper's map is run once per scene (20 000 iterations cost ~2 s
-each); the rigid strategy's curve is the median-time run of RUNS runs.
+count. The local/global strategies run once per scene (budget per scene in
+SCENES: 20 000 iterations, fewer on the Miura sheets); the rigid strategy's
+curve is the median-time run of RUNS runs (budget 200).
 Writes bench/results/convergence.json and .png.
 """
 from __future__ import annotations
@@ -37,10 +45,12 @@ from _meta import machine_meta
 
 RESULTS = Path(__file__).parent / "results"
 RUNS = 3
-BUDGET = {"paper": 20_000, "anderson": 20_000, "lbfgs": 20_000, "rigid": 200}
+RIGID_BUDGET = 200
+SOLVERS = ("rigid", "lbfgs", "anderson", "paper")
 STYLE = {"paper": "C0-", "anderson": "C1-", "lbfgs": "C2-", "rigid": "C3.-"}
 FLOOR_DEG = 1e-9  # a local/global run stops once this close (no curve below it is plotted)
 THRESHOLDS = (1.0, 0.1, 0.01)  # degrees
+PLOT_COLUMNS = 5
 
 
 def hinge_scene(ratio: float):
@@ -62,11 +72,43 @@ def pehrson_scene(rho1: float):
     return pattern, mesh, kinematics.degree4_deg(135.0, 90.0, rho1, "A"), [0, 1, 2, 3]
 
 
+def miura_scene(n: int, thickness: float):
+    """Miura n×n (a = b = 20, γ = 60°), W = 2H, k = 2; one interior zig-zag crease
+    actuated to 60° (facet tilt θ = 30°), all others passive."""
+    pattern = patterns.miura(n, n, a=20.0, b=20.0, gamma=60.0, width=2.0 * thickness)
+    kinds = patterns.miura_edge_kinds(n, n)
+    zigzag, straight = kinematics.miura_angles_deg(60.0, 30.0)
+    sign = np.select([pattern.assignments == "V", pattern.assignments == "M"], [1.0, -1.0], 0.0)
+    expected = sign * np.where(kinds == "zigzag", zigzag, straight)
+    creases = np.flatnonzero(kinds != "boundary")
+    zz = np.flatnonzero(kinds == "zigzag")
+    actuated = int(zz[len(zz) // 2])
+    angles = [None] * pattern.n_edges
+    angles[actuated] = float(expected[actuated])
+    pattern = pattern.replace(fold_angles=angles)
+    return pattern, thicken(pattern, thickness, subdivisions=2), expected[creases], creases
+
+
+def waterbomb_scene():
+    """6-crease waterbomb, R = 50, H = 0.05 (H/R = 1e-3), W = 2H, k = 2: the three
+    mountain (major) creases actuated to 90°, the valleys passive."""
+    pattern = patterns.waterbomb(6, radius=50.0, major="M", width=0.1, major_angle=90.0)
+    minor = float(kinematics.waterbomb_minor_deg(6, 90.0))
+    expected = np.where(pattern.assignments[:6] == "M", -90.0, minor)
+    return pattern, thicken(pattern, 0.05, subdivisions=2), expected, np.arange(6)
+
+
+# name: (scene factory, iteration budget of the local/global strategies)
 SCENES = {
-    **{f"hinge_LpH{r}": (lambda r=r: hinge_scene(float(r))) for r in (5, 20, 80, 320)},
-    "vertex_thin_actuated": thin_vertex_scene,
-    "pehrson_90": lambda: pehrson_scene(90.0),
-    "pehrson_flat": lambda: pehrson_scene(180.0),
+    **{f"hinge_LpH{r}": ((lambda r=r: hinge_scene(float(r))), 20_000) for r in (5, 20, 80, 320)},
+    "vertex_thin_actuated": (thin_vertex_scene, 20_000),
+    "pehrson_90": (lambda: pehrson_scene(90.0), 20_000),
+    "pehrson_flat": (lambda: pehrson_scene(180.0), 20_000),
+    "waterbomb6_thin": (waterbomb_scene, 20_000),
+    "miura5_thin": (lambda: miura_scene(5, 0.02), 5_000),
+    "miura5_thick": (lambda: miura_scene(5, 1.0), 5_000),
+    "miura20_thin": (lambda: miura_scene(20, 0.02), 1_000),
+    "miura20_thick": (lambda: miura_scene(20, 1.0), 1_000),
 }
 
 
@@ -96,11 +138,12 @@ def first_below(points, threshold):
     return None
 
 
-def measure_scene(name, make):
+def measure_scene(name, make, budget):
     rows = {}
-    for solver in ("rigid", "lbfgs", "anderson", "paper"):
+    for solver in SOLVERS:
         runs = RUNS if solver == "rigid" else 1
-        traces = [trace(make(), solver, BUDGET[solver], every=1 if solver == "rigid" else 20)
+        traces = [trace(make(), solver, RIGID_BUDGET if solver == "rigid" else budget,
+                        every=1 if solver == "rigid" else 20)
                   for _ in range(runs)]
         totals = [tr[0][-1][1] for tr in traces]
         points, result, sim = traces[int(np.argsort(totals)[len(totals) // 2])]
@@ -138,18 +181,26 @@ def plot(data, path: Path) -> None:
     import matplotlib.pyplot as plt
 
     names = list(data)
-    fig, axes = plt.subplots(2, len(names), figsize=(3.2 * len(names), 6), squeeze=False)
+    cols = PLOT_COLUMNS
+    groups = -(-len(names) // cols)
+    fig, axes = plt.subplots(2 * groups, cols, figsize=(3.2 * cols, 5.6 * groups),
+                             squeeze=False)
     for j, name in enumerate(names):
+        top, bottom = axes[2 * (j // cols), j % cols], axes[2 * (j // cols) + 1, j % cols]
         for solver, style in STYLE.items():
             pts = np.array(data[name][solver]["curve"])
             err = np.maximum(pts[:, 2], 1e-8)
-            axes[0, j].loglog(pts[:, 0], err, style, label=solver, ms=3)
-            axes[1, j].loglog(np.maximum(pts[:, 1], 1e-4), err, style, label=solver, ms=3)
-        axes[0, j].set_title(name, fontsize=9)
-        axes[0, j].set_xlabel("iterations")
-        axes[1, j].set_xlabel("strategy time, s")
-    axes[0, 0].set_ylabel("max fold-angle error, °")
-    axes[1, 0].set_ylabel("max fold-angle error, °")
+            top.loglog(pts[:, 0], err, style, label=solver, ms=3)
+            bottom.loglog(np.maximum(pts[:, 1], 1e-4), err, style, label=solver, ms=3)
+        top.set_title(name, fontsize=9)
+        top.set_xlabel("iterations")
+        bottom.set_xlabel("strategy time, s")
+        if j % cols == 0:
+            top.set_ylabel("max fold-angle error, °")
+            bottom.set_ylabel("max fold-angle error, °")
+    for j in range(len(names), groups * cols):
+        axes[2 * (j // cols), j % cols].axis("off")
+        axes[2 * (j // cols) + 1, j % cols].axis("off")
     axes[0, 0].legend()
     fig.tight_layout()
     fig.savefig(path, dpi=110)
@@ -160,14 +211,15 @@ def main() -> None:
     for solver in ("paper", "anderson", "lbfgs"):
         trace(hinge_scene(5.0), solver, 5)
     data = {}
-    for name, make in SCENES.items():
-        data[name] = measure_scene(name, make)
+    for name, (make, budget) in SCENES.items():
+        data[name] = measure_scene(name, make, budget)
+        data[name]["budget_local_global"] = budget
         if name.startswith("vertex"):
             data[name]["reference"] = reference(make)
     RESULTS.mkdir(exist_ok=True)
     meta = {**machine_meta(), "runs_rigid": RUNS, "runs_local_global": 1,
             "tolerance": {"rigid": 1e-10, "local_global": 0.0, "stop_below_deg": FLOOR_DEG},
-            "budget": BUDGET}
+            "budget_rigid": RIGID_BUDGET}
     (RESULTS / "convergence.json").write_text(json.dumps({"meta": meta, "scenes": data}))
     plot(data, RESULTS / "convergence.png")
 
