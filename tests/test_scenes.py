@@ -111,3 +111,16 @@ def test_demo_main_job_writes_each_scene(tmp_path, capsys):
     assert {p.name for p in tmp_path.iterdir()} == {"waterbomb.fold", "waterbomb.json",
                                                      "waterbomb.png"}
     assert "θm/θv -82.0/22.9" in capsys.readouterr().out
+
+
+def test_cli_scene_writes_outputs_and_refuses_bad_input(tmp_path, capsys):
+    from foldcore.cli import main
+
+    assert main(["scene", "miura", "--out", str(tmp_path), "--quick"]) == 0
+    assert {p.name for p in tmp_path.iterdir()} == {"miura.fold", "miura.json"}
+    report = json.loads((tmp_path / "miura.json").read_text())
+    assert report["quantities"]["zigzag"]["closed_form_deg"] == pytest.approx(60.0)
+    assert main(["scene", "miura", "--out", str(tmp_path / "missing")]) == 2
+    assert main(["scene", "box"]) == 2
+    err = capsys.readouterr().err
+    assert "missing: output folder does not exist" in err and "invalid choice: 'box'" in err

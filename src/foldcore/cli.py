@@ -1,5 +1,6 @@
 """Command line: ``foldcore simulate PATTERN [options]``, ``foldcore render RESULT.fold -o
-OUT.png [options]``, ``foldcore export RESULT.fold --svg/--dxf/--stl OUT``.
+OUT.png [options]``, ``foldcore export RESULT.fold --svg/--dxf/--stl OUT``,
+``foldcore scene NAME [--out DIR] [--render]`` (the paper's scenes, :mod:`foldcore.scenes`).
 
 ``simulate --animate OUT.gif|OUT.mp4`` also folds the pattern from 0 to
 ``--fold-percent`` in ``--frames`` steps (each continuing the previous state)
@@ -145,7 +146,38 @@ def build_parser() -> argparse.ArgumentParser:
     exp.add_argument("--dxf", help="flat sheet outlines as DXF (mm; needs the 'export' extra)")
     exp.add_argument("--stl", help="folded solid as binary STL (mm)")
     _add_rebuild_options(exp)
+
+    from .scenes import NAMES
+
+    scn = sub.add_parser("scene", help="fold one of the paper's scenes and write its outputs")
+    scn.add_argument("name", choices=list(NAMES), metavar="NAME",
+                     help="; ".join(f"{k}: {v}" for k, v in NAMES.items()))
+    scn.add_argument("--out", default=".", help="output folder (default: current folder)")
+    scn.add_argument("--render", action="store_true",
+                     help="also write NAME.png (needs the 'render' extra: pyvista)")
+    scn.add_argument("--solver", choices=SOLVERS,
+                     help="iteration strategy (default: the scene's own, see its docstring)")
+    scn.add_argument("--quick", action="store_true",
+                     help="lower iteration budgets (tests); same geometry")
     return parser
+
+
+def run_scene(args) -> int:
+    """Run ``foldcore scene``: NAME.fold and NAME.json (+ NAME.png) in --out."""
+    from pathlib import Path
+
+    from . import scenes
+    from .errors import FoldcoreError
+
+    if not Path(args.out).is_dir():
+        raise FoldcoreError(f"{args.out}: output folder does not exist")
+    run = scenes.run(args.name, quick=args.quick, solver=args.solver)
+    for path in scenes.write(run, args.out, png=args.render):
+        print(path)
+    if not run.result.converged:
+        print(f"foldcore: warning: {args.name}: the last run stopped at its iteration "
+              "budget without converging", file=sys.stderr)
+    return 0
 
 
 def _load(args):
@@ -251,7 +283,8 @@ def export_result(args) -> int:
     return 0
 
 
-COMMANDS = {"simulate": simulate, "render": render_result, "export": export_result}
+COMMANDS = {"simulate": simulate, "render": render_result, "export": export_result,
+            "scene": run_scene}
 
 
 def main(argv=None) -> int:
