@@ -35,6 +35,9 @@ from foldcore.io.obj import mesh_pattern, parse_hinges, parse_polygons
 from foldcore.pattern import CreasePattern
 from foldcore.planar import signed_area
 
+# reversed clockwise faces warn by design (tests/test_io.py checks that); here only noise
+pytestmark = pytest.mark.filterwarnings("ignore::foldcore.errors.PatternWarning")
+
 _HEALTH = [HealthCheck.too_slow, HealthCheck.data_too_large, HealthCheck.filter_too_much,
            HealthCheck.function_scoped_fixture]
 settings.register_profile("foldcore-fuzz", max_examples=300, deadline=None,
