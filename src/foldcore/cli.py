@@ -135,9 +135,11 @@ def build_parser() -> argparse.ArgumentParser:
                      help="camera: iso (default), top, side (from +x), front (from -y)")
     ren.add_argument("--size", type=_size, default=(1024, 768),
                      help="picture size WIDTHxHEIGHT in pixels (default 1024x768)")
-    ren.add_argument("--color-by", default="none", choices=("angle", "strip-angle", "none"),
+    ren.add_argument("--color-by", default="none",
+                     choices=("angle", "strip-angle", "strain", "none"),
                      help="hinge colours: mountain/valley (none, default), each crease's fold "
-                          "angle (angle) or each sub-strip's bend angle (strip-angle), degrees")
+                          "angle (angle) or each sub-strip's bend angle (strip-angle), degrees, "
+                          "or each sub-strip's largest surface tension (strain)")
     _add_rebuild_options(ren)
 
     exp = sub.add_parser("export", help="fabrication files of a result FOLD (simulate -o)")
@@ -261,7 +263,15 @@ def render_result(args) -> int:
 
     res = read_result(args.result, args.hinge_width, args.subdivisions)
     options = {}
-    if args.color_by != "none":   # signed angles, valley > 0: blue, mountain < 0: red
+    if args.color_by == "strain":   # largest surface tension of each sub-strip
+        from .strain import estimated_strip_angles, strip_strains
+
+        hinges = res.mesh.groups["bending_hinge"]
+        values = strip_strains(hinges.params,
+                               estimated_strip_angles(hinges, res.positions)).max(axis=1)
+        options = dict(scalars=values, clim=colour_limits(values, signed=False),
+                       cmap="viridis", scalar_name="surface tension strain")
+    elif args.color_by != "none":   # signed angles, valley > 0: blue, mountain < 0: red
         angle = args.color_by == "angle"
         values = fold_angles(res.pattern, res.mesh, res.positions) if angle \
             else strip_bend_angles(res.mesh, res.positions)

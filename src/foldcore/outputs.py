@@ -24,6 +24,15 @@ def _nullable(values) -> list:
     return [float(v) if np.isfinite(v) else None for v in np.asarray(values, dtype=float)]
 
 
+def _strain_entries(result) -> dict:
+    """Sub-strip surface strains (top, bottom; dimensionless) and hinge failures."""
+    if result.strip_strains is None:
+        return {}
+    return {"strip_strains": {"top": result.strip_strains[:, 0].tolist(),
+                              "bottom": result.strip_strains[:, 1].tolist()},
+            "failures": result.failures}
+
+
 def _iteration_cost(result) -> dict:
     """Mean strategy time per iteration (s) and its ratio to one bare K⁻¹ solve."""
     t = result.timings_s
@@ -54,6 +63,7 @@ def report_dict(result, pattern, mesh, settings: dict, quantities: dict | None =
         "fold_angles_deg": _nullable(result.fold_angles_deg),
         "target_angles_deg": _nullable(pattern.fold_angles),
         "strip_angles_deg": result.strip_angles_deg.tolist(),
+        **_strain_entries(result),
         "vertices": int(mesh.n_vertices),
         "elements": {name: len(g) for name, g in mesh.groups.items()},
         "hinge_width_mm": _nullable(mesh.hinge_width),

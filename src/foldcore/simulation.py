@@ -58,6 +58,10 @@ class Result:
     timings_s : dict with ``setup``, ``projection``, ``solve``, ``total`` (setup + every
         :meth:`Simulation.run` so far) and, after
         :meth:`Simulation.run`, ``bare_solve`` (one K⁻¹ solve, the floor) (seconds)
+    strip_strains : (S, 2) float, top and bottom surface strain of each hinge
+        sub-strip from its current shape (:mod:`foldcore.strain`), dimensionless
+    failures : list of dict, hinges that exceeded their strain limits (first
+        iteration each; empty without ``strain_limits``)
     """
 
     positions: np.ndarray
@@ -67,6 +71,8 @@ class Result:
     iterations: int
     converged: bool
     timings_s: dict = field(default_factory=dict)
+    strip_strains: np.ndarray | None = None
+    failures: list = field(default_factory=list)
 
 
 class _GroupRun:
@@ -121,6 +127,11 @@ class Simulation:
         paper's projection alone (``1``) only sets the target at the bound, so
         a position target on a long lever bends a small hinge far past it.
         Each change of the set of stops costs one numeric refactor.
+    strain_limits : StrainLimits, optional
+        Material limits of the hinges (:class:`foldcore.strain.StrainLimits`);
+        each iteration then checks every sub-strip's surface strain and the
+        result lists the creases that failed, with the iteration and fold
+        percent of their first failure.
     threads : int, optional
         numba threads for the kernels of this simulation (set at each step,
         so simulations in one process do not override each other). Default:
@@ -132,7 +143,7 @@ class Simulation:
 
     def __init__(self, mesh, pattern, solver: str = "paper", backend: str = "auto",
                  passive_floor_deg: float = 0.0, stop_stiffness: float = 1e3,
-                 threads: int | None = None):
+                 threads: int | None = None, strain_limits=None):
         start = time.perf_counter()
         if solver not in SOLVERS:
             raise SimulationError(f"unknown solver {solver!r} (available: {', '.join(SOLVERS)})")
@@ -160,6 +171,7 @@ class Simulation:
         self.energy_history: list[float] = []
         self.timings = {"setup": time.perf_counter() - start, "projection": 0.0, "solve": 0.0}
         self.length_scale = float(np.ptp(pattern.vertices, axis=0).max())
+        self._monitor = self._failure_monitor(strain_limits)
         self._rigid = self._accelerated = None
         if solver == "rigid":
             from .rigid_body import RigidBodySolver
@@ -258,6 +270,8 @@ class Simulation:
             energy, moved = self._paper_iteration()
         self.energy_history.append(energy)
         self.iterations += 1
+        if self._monitor is not None:
+            self._monitor.check(self.x, self.iterations, self._percent)
         self._advance_alpha()
         return moved
 
@@ -373,14 +387,38 @@ class Simulation:
             return np.zeros(0)
         return np.degrees(self._hinges.state[:, 0])
 
+    def strip_strains(self) -> np.ndarray:
+        """(S, 2) top/bottom surface strain of each sub-strip at the current shape."""
+        if self._hinges is None:
+            return np.zeros((0, 2))
+        from .strain import estimated_strip_angles, strip_strains
+
+        g = self._hinges.group
+        return strip_strains(g.params, estimated_strip_angles(g, self.x))
+
     def result(self, converged: bool) -> Result:
         """Snapshot of the current state as a :class:`Result`."""
         timings = {k: float(v) for k, v in self.timings.items()}
         timings.setdefault("total", sum(timings.values()))
         return Result(self.x.copy(), self.fold_angles(), self.strip_angles(),
-                      np.array(self.energy_history), self.iterations, converged, timings)
+                      np.array(self.energy_history), self.iterations, converged, timings,
+                      self.strip_strains(),
+                      list(self._monitor.failures) if self._monitor is not None else [])
 
     # --------------------------------------------------------------- private
+    def _failure_monitor(self, limits):
+        if limits is None or self._hinges is None:
+            return None
+        from .strain import FailureMonitor, StrainLimits
+
+        if not isinstance(limits, StrainLimits):
+            raise SimulationError(f"strain_limits must be a foldcore.strain.StrainLimits, "
+                                  f"got {type(limits).__name__}")
+        try:
+            return FailureMonitor(self._hinges.group, limits, self.pattern.n_edges)
+        except ValueError as exc:
+            raise SimulationError(str(exc)) from None
+
     @staticmethod
     def _choose_threads(threads, slots: int) -> int:
         if threads is None:

@@ -1,0 +1,110 @@
+"""Surface strain of hinge sub-strips and material limits (paper §6.4, beyond it).
+
+A sub-strip of width w = W/k and thickness H bent by φ (its share of the
+crease's angle, valley > 0) stretches its faces by s(y) − 1, y = ±H/2 the
+top/bottom face (the neutral surface y = 0 keeps its length):
+
+* exact arc (foldcore's default target): s(y) = 1 − φ·y/w, so
+  ε_top = −φH/(2w), ε_bottom = +φH/(2w);
+* Eq. 8 trapezoid: s(y) = 1 − (2y/w)·tan(φ/2), so
+  ε_top = −(H/w)·tan(φ/2), ε_bottom = +(H/w)·tan(φ/2).
+
+Valley folds compress the top face and stretch the bottom one; mountain
+folds the reverse. φ is the Eq. 9 estimate from the strip's current shape,
+so the strain follows the mesh, not the target. A hinge *fails* when a face's
+tension exceeds εt or its compression exceeds εc (both positive magnitudes,
+dimensionless); :class:`FailureMonitor` records the first iteration at which
+each crease does. Fold angle at failure: the crease's Σ φ of its sub-strips.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from elements.bending_hinge import EXACT, H, W, estimate_angles
+
+TOP, BOTTOM = 0, 1
+
+
+def strip_strains(params: np.ndarray, phi: np.ndarray) -> np.ndarray:
+    """(S, 2) surface strains (top, bottom) of sub-strips bent by ``phi`` (S,) rad.
+
+    ``params`` (S, 7) are the hinge parameters (``HINGE_PARAMS``): width w,
+    height H and the target kind decide the formula (module docstring).
+    """
+    ratio = params[:, H] / params[:, W]
+    arc = 0.5 * phi * ratio
+    trapezoid = ratio * np.tan(0.5 * phi)
+    bottom = np.where(params[:, EXACT] > 0.5, arc, trapezoid)
+    return np.column_stack([-bottom, bottom])
+
+
+def estimated_strip_angles(hinge_group, positions: np.ndarray) -> np.ndarray:
+    """(S,) Eq. 9 bend angle (rad) of every sub-strip at ``positions`` (N, 3) mm."""
+    out = np.zeros(len(hinge_group))
+    estimate_angles(positions, hinge_group.indptr, hinge_group.indices, out)
+    return out
+
+
+@dataclass(frozen=True)
+class StrainLimits:
+    """Material limits of the hinges: largest tension and compression (> 0).
+
+    Attributes
+    ----------
+    tension, compression : float or (E,) float
+        Per crease (edge id) or for all, dimensionless strain magnitudes;
+        ``inf`` disables a side.
+    """
+
+    tension: object = np.inf
+    compression: object = np.inf
+
+    def per_edge(self, n_edges: int) -> tuple[np.ndarray, np.ndarray]:
+        """(E,) tension and compression limits, validated (positive, not NaN)."""
+        out = []
+        for name, value in (("tension", self.tension), ("compression", self.compression)):
+            limit = np.broadcast_to(np.asarray(value, dtype=float), (n_edges,)).copy()
+            if not (limit > 0).all():
+                raise ValueError(f"strain limit {name} must be > 0 (inf to disable), "
+                                 f"got {value!r}")
+            out.append(limit)
+        return out[0], out[1]
+
+
+class FailureMonitor:
+    """First iteration at which each crease's hinge exceeds its strain limits.
+
+    Parameters
+    ----------
+    hinge_group : ElementGroup of ``bending_hinge``
+    limits : StrainLimits
+    n_edges : int
+    """
+
+    def __init__(self, hinge_group, limits: StrainLimits, n_edges: int):
+        self.group = hinge_group
+        tension, compression = limits.per_edge(n_edges)
+        self.tension = tension[hinge_group.source]
+        self.compression = compression[hinge_group.source]
+        self.failures: list[dict] = []
+        self._failed = set()
+
+    def check(self, positions: np.ndarray, iteration: int, fold_percent: float) -> None:
+        """Record creases whose sub-strips exceed a limit now (first time only)."""
+        phi = estimated_strip_angles(self.group, positions)
+        strain = strip_strains(self.group.params, phi)
+        over_t = strain.max(axis=1) > self.tension
+        over_c = -strain.min(axis=1) > self.compression
+        for s in np.flatnonzero(over_t | over_c):
+            edge = int(self.group.source[s])
+            if edge in self._failed:
+                continue
+            self._failed.add(edge)
+            mine = self.group.source == edge
+            self.failures.append({
+                "edge": edge, "iteration": int(iteration), "fold_percent": float(fold_percent),
+                "mode": "tension" if over_t[s] else "compression",
+                "strain": float(strain[s].max() if over_t[s] else strain[s].min()),
+                "fold_angle_deg": float(np.degrees(phi[mine].sum()))})
