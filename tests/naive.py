@@ -112,7 +112,20 @@ def _bending_hinge_element(x_elem, rest, params):
     return out, energy, (phi,)
 
 
-NAIVE = {"rigid_panel": _rigid_panel_element, "bending_hinge": _bending_hinge_element}
+# ------------------------------------------------- bar (examples/plugin_bar)
+def _bar_element(x_elem, rest, params):
+    """Segment of the rest length along the current direction, about the midpoint."""
+    p = np.asarray(x_elem, float) - np.mean(x_elem, axis=0)
+    length = np.linalg.norm(rest[1] - rest[0])
+    d = p[1] - p[0]
+    n = np.linalg.norm(d)
+    u = d / n if n > 0 else (rest[1] - rest[0]) / length
+    out = np.array([-0.5 * length * u, 0.5 * length * u])
+    return out, float(np.sum((p - out) ** 2)), ()
+
+
+NAIVE = {"rigid_panel": _rigid_panel_element, "bending_hinge": _bending_hinge_element,
+         "bar": _bar_element}
 
 
 def project_group(etype_name, x, group_like, params=None):

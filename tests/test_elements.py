@@ -12,10 +12,13 @@ Units: mm, radians.
 """
 from __future__ import annotations
 
+import dataclasses
 import functools
 import math
+import sys
 import warnings
 from dataclasses import dataclass
+from pathlib import Path
 from types import SimpleNamespace
 from typing import Callable
 
@@ -29,6 +32,11 @@ from elements import _registry
 from foldcore import patterns
 from foldcore.system import gather, vertex_slots
 from foldcore.thickening import thicken
+
+# the user-defined type of examples/plugin_bar is registered by importing it, as a
+# user's code would; the contracts below then cover it like a built-in type
+sys.path.insert(0, str(Path(__file__).parent.parent / "examples" / "plugin_bar"))
+import bar as plugin_bar  # noqa: E402
 
 W, H, TARGET, SIGN, MAX_ANGLE, FLOOR, EXACT = range(7)
 TYPES = elements.available()
@@ -55,7 +63,19 @@ def scenes() -> dict:
         "degree4_arc": thicken(patterns.degree4_vertex(rho1=40.0), 2.0),
         "degree4_B_eq8": thicken(patterns.degree4_vertex(mode="B", rho1=-30.0), 2.0,
                                  exact_arc=False),
+        "hinge_with_bars": _with_bars(thicken(sh(angle=90.0, width=4.0), 1.0,
+                                              subdivisions=2)),
     }
+
+
+def _with_bars(mesh):
+    """The mesh plus bars between every 7th pair of vertices (plugin type ``bar``)."""
+    ends = np.column_stack([np.arange(0, mesh.n_vertices - 7, 7),
+                            np.arange(7, mesh.n_vertices, 7)])
+    rest = mesh.rest_positions
+    lengths = np.linalg.norm(rest[ends[:, 1]] - rest[ends[:, 0]], axis=1)
+    group = plugin_bar.bar_group(ends, lengths, np.ones(len(ends)))
+    return dataclasses.replace(mesh, groups={**mesh.groups, "bar": group})
 
 
 # ------------------------------------------------------------- type specs
@@ -106,6 +126,7 @@ class Spec:
 SPECS = {
     "rigid_panel": Spec(_same, _same, _same, _rest_shape),
     "bending_hinge": Spec(_hinge_rest, _hinge_live, _hinge_random, _hinge_bent),
+    "bar": Spec(_same, _same, _same, _rest_shape),
 }
 
 
