@@ -112,6 +112,22 @@ def _bending_hinge_element(x_elem, rest, params):
     return out, energy, (phi,)
 
 
+# ------------------------------------------------------------ stretch hinge
+def _stretch_hinge_element(x_elem, rest, params):
+    """Rest strip scaled by (λ, 1, λ^(−ν)) in its local frame, rotated onto x.
+
+    λ = params[2], or for NaN the mean of the strip's four width edges over W.
+    """
+    x_elem = np.asarray(x_elem, float)
+    width, _, ratio, poisson = params
+    if np.isnan(ratio):
+        ratio = np.mean([np.linalg.norm(x_elem[i] - x_elem[j])
+                         for i, j in ((0, 1), (3, 2), (4, 5), (7, 6))]) / width
+    target = np.asarray(rest, float) * np.array([ratio, 1.0, ratio ** -poisson])
+    out, energy = fit(x_elem, target)
+    return out, energy, (ratio,)
+
+
 # ------------------------------------------------- bar (examples/plugin_bar)
 def _bar_element(x_elem, rest, params):
     """Segment of the rest length along the current direction, about the midpoint."""
@@ -125,7 +141,7 @@ def _bar_element(x_elem, rest, params):
 
 
 NAIVE = {"rigid_panel": _rigid_panel_element, "bending_hinge": _bending_hinge_element,
-         "bar": _bar_element}
+         "stretch_hinge": _stretch_hinge_element, "bar": _bar_element}
 
 
 def project_group(etype_name, x, group_like, params=None):

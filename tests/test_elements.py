@@ -63,6 +63,7 @@ def scenes() -> dict:
         "degree4_arc": thicken(patterns.degree4_vertex(rho1=40.0), 2.0),
         "degree4_B_eq8": thicken(patterns.degree4_vertex(mode="B", rho1=-30.0), 2.0,
                                  exact_arc=False),
+        "hinge_stretch": thicken(sh(width=2.0), 1.0, stretch={0: 0.3}),
         "hinge_with_bars": _with_bars(thicken(sh(angle=90.0, width=4.0), 1.0,
                                               subdivisions=2)),
     }
@@ -115,6 +116,31 @@ def _hinge_bent(rest, params, rng):
     return naive.bent_target(rest, params[W], rng.uniform(-2.6, 2.6), params[EXACT] > 0.5)
 
 
+def _stretch_rest(p, rng=None):
+    """Passive strips estimate λ = 1 at rest: the rest shape is their fixed point."""
+    p = p.copy()
+    p[:, 2] = np.nan
+    return p
+
+
+def _stretch_live(p, rng=None):
+    p = p.copy()
+    p[:, 2] = 1.15
+    return p
+
+
+def _stretch_random(p, rng):
+    p, n = p.copy(), len(p)
+    p[:, 2] = np.where(rng.random(n) < 0.5, rng.uniform(0.7, 1.5, n), np.nan)
+    p[:, 3] = rng.uniform(-0.5, 0.5, n)
+    return p
+
+
+def _stretch_shape(rest, params, rng):
+    ratio = rng.uniform(0.7, 1.5)
+    return rest * np.array([ratio, 1.0, ratio ** -params[3]])
+
+
 @dataclass(frozen=True)
 class Spec:
     rest_params: Callable     # params under which the rest shape is a fixed point
@@ -126,6 +152,7 @@ class Spec:
 SPECS = {
     "rigid_panel": Spec(_same, _same, _same, _rest_shape),
     "bending_hinge": Spec(_hinge_rest, _hinge_live, _hinge_random, _hinge_bent),
+    "stretch_hinge": Spec(_stretch_rest, _stretch_live, _stretch_random, _stretch_shape),
     "bar": Spec(_same, _same, _same, _rest_shape),
 }
 
@@ -138,7 +165,8 @@ def spec(name) -> Spec:
 
 
 def groups_of(name) -> list:
-    found = [(s, m, m.groups[name]) for s, m in scenes().items() if name in m.groups]
+    found = [(s, m, m.groups[name]) for s, m in scenes().items()
+             if name in m.groups and len(m.groups[name])]
     if not found:
         pytest.fail(f"no test scene builds a group of element type {name!r}")
     return found

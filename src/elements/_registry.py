@@ -7,7 +7,8 @@ from importlib.metadata import entry_points
 
 _REGISTRY: dict[str, type] = {}
 _BUILTIN_MODULES = {"rigid_panel": "elements.rigid_panel",
-                    "bending_hinge": "elements.bending_hinge"}
+                    "bending_hinge": "elements.bending_hinge",
+                    "stretch_hinge": "elements.stretch_hinge"}
 ENTRY_POINT_GROUP = "foldcore.elements"
 
 

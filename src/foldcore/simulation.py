@@ -155,10 +155,12 @@ class Simulation:
                 self._runs.append(_GroupRun(g, offset))
                 offset += len(g.indices)
         self.threads = self._choose_threads(threads, offset)
+        self._check_every_vertex_used()
         self._targets = np.zeros((offset, 3))
         self._rhs = np.zeros((mesh.n_vertices, 3))
         self.system = System([r.group for r in self._runs], mesh.n_vertices, backend)
         self._hinges = next((r for r in self._runs if r.group.kind == "bending_hinge"), None)
+        self._stretch = next((r for r in self._runs if r.group.kind == "stretch_hinge"), None)
         self._init_stops(stop_stiffness)
         self._fold_targets = np.array(pattern.fold_angles, dtype=float)
         self._fold_targets[pattern.assignments == "F"] = 0.0
@@ -197,6 +199,42 @@ class Simulation:
             new[e] = self._checked_angle(e, angle)
         self._fold_targets = new
         self._apply_fold_targets()
+
+    def set_stretch_ratios(self, ratios: dict) -> None:
+        """Actuate stretch hinges (§6.3): ``{edge id: λ or None}``.
+
+        λ > 0 is the width ratio of the crease's strip (its length follows
+        λ^(−ν)); ``None`` makes it passive (free to stretch). Only creases made
+        stretch hinges by ``thicken(..., stretch=...)`` take a ratio.
+        """
+        from elements.stretch_hinge import RATIO
+
+        run = self._stretch
+        for e, ratio in dict(ratios).items():
+            rows = np.zeros(0, dtype=bool) if run is None else run.group.source == int(e)
+            if not rows.any():
+                raise SimulationError(f"edge {e} is not a stretch hinge (see thicken's "
+                                      "'stretch' argument)")
+            if ratio is not None and not (np.isfinite(ratio) and ratio > 0):
+                raise SimulationError(f"edge {e}: stretch ratio must be a positive number, "
+                                      f"got {ratio!r}")
+            run.params[rows, RATIO] = np.nan if ratio is None else float(ratio)
+
+    def stretch_ratios(self) -> np.ndarray:
+        """(T, 2) measured width and length ratios of each stretch strip (current / rest)."""
+        if self._stretch is None:
+            return np.zeros((0, 2))
+        g = self._stretch.group
+        ids = g.indices.reshape(len(g), 8)
+        rest = self.mesh.rest_positions
+
+        def mean_length(pos, pairs):
+            return np.mean([np.linalg.norm(pos[ids[:, i]] - pos[ids[:, j]], axis=1)
+                            for i, j in pairs], axis=0)
+
+        across, along = ((0, 1), (3, 2), (4, 5), (7, 6)), ((0, 3), (1, 2), (4, 7), (5, 6))
+        return np.column_stack([mean_length(self.x, across) / mean_length(rest, across),
+                                mean_length(self.x, along) / mean_length(rest, along)])
 
     def set_fold_percent(self, percent: float) -> None:
         """Scale every actuated target by ``percent``/100 (−100…100, as in other tools)."""
@@ -378,7 +416,11 @@ class Simulation:
         return self.x
 
     def fold_angles(self) -> np.ndarray:
-        """(E,) fold angles in degrees from the panels' mid-planes (NaN for B)."""
+        """(E,) fold angles in degrees from the panels' mid-planes (NaN for B, and for
+        every edge of a mesh without panels)."""
+        panels = self.mesh.groups.get(self.mesh.panel_group)
+        if panels is None or not len(panels):
+            return np.full(self.pattern.n_edges, np.nan)
         return fold_angles(self.pattern, self.mesh, self.x)
 
     def strip_angles(self) -> np.ndarray:
@@ -406,6 +448,16 @@ class Simulation:
                       list(self._monitor.failures) if self._monitor is not None else [])
 
     # --------------------------------------------------------------- private
+    def _check_every_vertex_used(self) -> None:
+        """A vertex in no element has no equation: K would be singular there."""
+        used = np.zeros(self.mesh.n_vertices, dtype=bool)
+        for run in self._runs:
+            used[run.group.indices] = True
+        if not used.all():
+            raise SimulationError(f"vertex {int(np.argmin(used))} belongs to no element "
+                                  f"({int((~used).sum())} such vertices): the mesh's groups "
+                                  "must cover every vertex")
+
     def _failure_monitor(self, limits):
         if limits is None or self._hinges is None:
             return None
@@ -434,6 +486,9 @@ class Simulation:
             raise SimulationError(f"edge {e} does not exist (0..{self.pattern.n_edges - 1})")
         if self.pattern.assignments[e] == "B":
             raise SimulationError(f"edge {e} is a boundary edge and has no hinge")
+        if self._stretch is not None and (self._stretch.group.source == e).any():
+            raise SimulationError(f"edge {e} is a stretch hinge: set its stretch ratio "
+                                  "(set_stretch_ratios), not a fold angle")
         return e
 
     def _checked_angle(self, e: int, angle) -> float:

@@ -220,7 +220,7 @@ def _attach_strip_sides(pattern, e, lines, corners, corner_ids, table, inserts, 
 
 def thicken(pattern: CreasePattern, thickness: float, hinge_width=None,
             subdivisions="auto", bend_radius: float = 0.0, exact_arc: bool = True,
-            stiffness=None) -> ThickMesh:
+            stiffness=None, stretch=None) -> ThickMesh:
     """Build the thick prism mesh of a crease pattern (paper §2.2).
 
     Parameters
@@ -241,6 +241,11 @@ def thicken(pattern: CreasePattern, thickness: float, hinge_width=None,
     stiffness : dict, optional
         ``{"panel": (F,) or float, "hinge": (E,) or float}`` stiffness factors
         multiplying the volume weights (dimensionless, default 1).
+    stretch : dict {edge id: Poisson ratio ν}, optional
+        Creases made *stretch* hinges (§6.3, :mod:`elements.stretch_hinge`,
+        one strip each, group ``stretch_hinge``) instead of bending hinges;
+        ν in [−1, 0.5]. They start passive (free to stretch); actuate them
+        with :meth:`foldcore.Simulation.set_stretch_ratios`.
 
     Returns
     -------
@@ -251,6 +256,8 @@ def thicken(pattern: CreasePattern, thickness: float, hinge_width=None,
                         f"got {thickness}")
     widths = _resolve_widths(pattern, thickness, hinge_width, bend_radius)
     ks = _resolve_subdivisions(pattern, widths, thickness, subdivisions, exact_arc)
+    stretch = _resolve_stretch(pattern, stretch)
+    ks[list(stretch)] = 1
     table = _PointTable()
     corners, corner_ids = _corner_ids(pattern, widths, table)
     inserts: list[dict] = [dict() for _ in pattern.faces]
@@ -265,10 +272,14 @@ def thicken(pattern: CreasePattern, thickness: float, hinge_width=None,
     stiff = stiffness or {}
     panels = _panel_group(pattern, points, corner_ids, inserts, thickness,
                           stiff.get("panel", 1.0))
-    hinges, strips_of = _hinge_group(pattern, points, strip_points, widths, ks, thickness,
+    bending = {e: lines for e, lines in strip_points.items() if e not in stretch}
+    hinges, strips_of = _hinge_group(pattern, points, bending, widths, ks, thickness,
                                      exact_arc, stiff.get("hinge", 1.0))
-    return ThickMesh(points=points, thickness=float(thickness),
-                     groups={"rigid_panel": panels, "bending_hinge": hinges},
+    groups = {"rigid_panel": panels, "bending_hinge": hinges}
+    if stretch:
+        groups["stretch_hinge"] = _stretch_group(pattern, points, strip_points, stretch,
+                                                 widths, thickness, stiff.get("hinge", 1.0))
+    return ThickMesh(points=points, thickness=float(thickness), groups=groups,
                      panel_of_face=np.arange(len(pattern.faces), dtype=np.int64),
                      strips_of_crease=strips_of, hinge_width=widths, subdivisions=ks)
 
@@ -330,8 +341,49 @@ def _hinge_group(pattern, points, strip_points, widths, ks, thickness, exact_arc
             source.append(e)
     vols = np.array(vols)
     src = np.array(source, dtype=np.int64)
-    return _group("bending_hinge", loops, rests, np.array(params).reshape(len(loops), -1),
+    return _group("bending_hinge", loops, rests,
+                  np.array(params).reshape(len(loops), len(HINGE_PARAMS)),
                   vols, vols * stiff_e[src] if len(src) else vols, src), strips_of
+
+
+def _resolve_stretch(pattern, stretch) -> dict:
+    """{crease edge id: ν} of the stretch hinges, validated."""
+    out = {}
+    for e, nu in dict(stretch or {}).items():
+        e = int(e)
+        if not 0 <= e < pattern.n_edges or pattern.assignments[e] == "B":
+            raise MeshError(f"{pattern.source}: stretch hinge: edge {e} is not a crease")
+        if np.isfinite(pattern.fold_angles[e]):
+            raise MeshError(f"{pattern.source}: edge {e} has a fold-angle target but is a "
+                            "stretch hinge (actuated by its stretch ratio, not an angle)")
+        if not (np.isfinite(nu) and -1.0 <= nu <= 0.5):
+            raise MeshError(f"{pattern.source}: stretch hinge on edge {e}: Poisson ratio "
+                            f"must be in [-1, 0.5], got {nu!r}")
+        out[e] = float(nu)
+    return out
+
+
+def _stretch_group(pattern, points, strip_points, stretch, widths, thickness, stiffness):
+    """One stretch strip per stretch crease (its whole width), passive (λ = NaN)."""
+    from elements.stretch_hinge import STRETCH_PARAMS
+
+    n_top = len(points)
+    stiff_e = np.broadcast_to(np.asarray(stiffness, dtype=float), (pattern.n_edges,))
+    loops, rests, params, vols = [], [], [], []
+    for e, nu in stretch.items():
+        (a0, b0), (a1, b1) = strip_points[e][0], strip_points[e][-1]
+        loop2d, rest = _prism([a0, a1, b1, b0], points, thickness)
+        loops.append(np.concatenate([loop2d, loop2d + n_top]))
+        rests.append(rest @ _hinge_frame(pattern, e))
+        row = np.zeros(len(STRETCH_PARAMS))
+        row[[STRETCH_PARAMS.index(k) for k in ("width", "height", "ratio", "poisson")]] = \
+            (widths[e], thickness, np.nan, nu)
+        params.append(row)
+        vols.append(widths[e] * float(np.linalg.norm(points[b0] - points[a0])) * thickness)
+    src = np.array(list(stretch), dtype=np.int64)
+    vols = np.array(vols)
+    return _group("stretch_hinge", loops, rests, np.array(params), vols, vols * stiff_e[src],
+                  src)
 
 
 def _hinge_frame(pattern, e) -> np.ndarray:
