@@ -190,8 +190,8 @@ def _load(args):
         if args.hinges:
             raise PatternError(f"{args.pattern}: --hinges only goes with an OBJ/STL pattern")
         fold = read_fold_file(args.pattern)
-        return fold.pattern, fold.thickness
-    return read(args.pattern, hinges=args.hinges), None
+        return fold.pattern, fold.thickness, fold.stiffness
+    return read(args.pattern, hinges=args.hinges), None, None
 
 
 def simulate(args) -> int:
@@ -203,7 +203,7 @@ def simulate(args) -> int:
 
     if args.max_iterations < 1:
         raise SimulationError(f"--max-iterations must be ≥ 1, got {args.max_iterations}")
-    pattern, file_thickness = _load(args)
+    pattern, file_thickness, stiffness = _load(args)
     thickness = args.thickness or file_thickness
     if thickness is None:
         raise SimulationError(f"{args.pattern}: no thickness: pass --thickness H (mm) "
@@ -212,7 +212,7 @@ def simulate(args) -> int:
         from .animate import check_output
         check_output(args.animate)          # a missing encoder fails before any work
     mesh = thicken(pattern, thickness, args.hinge_width, args.subdivisions,
-                   exact_arc=not args.eq8)
+                   exact_arc=not args.eq8, stiffness=stiffness)
     sim = Simulation(mesh, pattern, solver=args.solver)
     if args.animate:
         result = _animate(args, sim)

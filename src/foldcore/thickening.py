@@ -240,7 +240,15 @@ def thicken(pattern: CreasePattern, thickness: float, hinge_width=None,
         Hinge targets on the exact circular arc (True) or Eq. 8's trapezoids.
     stiffness : dict, optional
         ``{"panel": (F,) or float, "hinge": (E,) or float}`` stiffness factors
-        multiplying the volume weights (dimensionless, default 1).
+        multiplying the volume weights (dimensionless, > 0, default 1). Each
+        element's energy is weight × ‖its deviation from its target‖², so a
+        factor s makes an element s times as costly to strain as the same
+        volume of the base material — a material s times stiffer (linear
+        elastic energy ½Eε² per volume). Factors change nothing where every
+        target can be met; where targets conflict (closed loops, incompatible
+        actuation, position targets) they decide the compromise.
+        FOLD files carry them as ``foldcore:edges_stiffness`` /
+        ``foldcore:faces_stiffness`` (:class:`foldcore.io.FoldFile`).
     stretch : dict {edge id: Poisson ratio ν}, optional
         Creases made *stretch* hinges (§6.3, :mod:`elements.stretch_hinge`,
         one strip each, group ``stretch_hinge``) instead of bending hinges;
@@ -254,6 +262,7 @@ def thicken(pattern: CreasePattern, thickness: float, hinge_width=None,
     if not (np.isfinite(thickness) and thickness > 0):
         raise MeshError(f"{pattern.source}: thickness must be a positive number of mm, "
                         f"got {thickness}")
+    _check_stiffness(pattern, stiffness)
     widths = _resolve_widths(pattern, thickness, hinge_width, bend_radius)
     ks = _resolve_subdivisions(pattern, widths, thickness, subdivisions, exact_arc)
     stretch = _resolve_stretch(pattern, stretch)
@@ -344,6 +353,24 @@ def _hinge_group(pattern, points, strip_points, widths, ks, thickness, exact_arc
     return _group("bending_hinge", loops, rests,
                   np.array(params).reshape(len(loops), len(HINGE_PARAMS)),
                   vols, vols * stiff_e[src] if len(src) else vols, src), strips_of
+
+
+def _check_stiffness(pattern, stiffness) -> None:
+    """Stiffness factors: known keys, right lengths, positive and finite."""
+    counts = {"panel": (len(pattern.faces), "face"), "hinge": (pattern.n_edges, "edge")}
+    for key, value in dict(stiffness or {}).items():
+        if key not in counts:
+            raise MeshError(f"{pattern.source}: stiffness key {key!r} is not 'panel' or 'hinge'")
+        n, item = counts[key]
+        factors = np.asarray(value, dtype=float)
+        if factors.ndim and factors.shape != (n,):
+            raise MeshError(f"{pattern.source}: stiffness[{key!r}] needs one factor per {item} "
+                            f"({n}) or one for all, got shape {factors.shape}")
+        bad = np.flatnonzero(~(np.atleast_1d(factors) > 0) | ~np.isfinite(np.atleast_1d(factors)))
+        if len(bad):
+            where = f" ({item} {bad[0]})" if factors.ndim else ""
+            raise MeshError(f"{pattern.source}: stiffness[{key!r}]{where} must be a positive "
+                            f"finite factor, got {np.atleast_1d(factors)[bad[0]]!r}")
 
 
 def _resolve_stretch(pattern, stretch) -> dict:

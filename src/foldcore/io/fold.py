@@ -56,6 +56,8 @@ WIDTH_KEY = "foldcore:edges_width"
 MAX_ANGLE_KEY = "foldcore:edges_maxAngle"
 THICKNESS_KEY = "foldcore:thickness"
 TARGET_KEY = "foldcore:edges_targetAngle"
+EDGE_STIFFNESS_KEY = "foldcore:edges_stiffness"
+FACE_STIFFNESS_KEY = "foldcore:faces_stiffness"
 #: What a JSON array may be in a FOLD dict: a list, or a tuple from a Python caller.
 ARRAY = (list, tuple)
 
@@ -72,11 +74,17 @@ class FoldFile:
         Sheet thickness in mm (``foldcore:thickness``); None when absent.
     frame_unit : str
         The unit the file declared (``"unit"`` when absent); already applied.
+    stiffness : dict or None
+        ``{"hinge": (E,) float, "panel": (F,) float}`` stiffness factors from
+        ``foldcore:edges_stiffness`` / ``foldcore:faces_stiffness``
+        (dimensionless, null → 1; see :func:`foldcore.thicken`), ready for
+        ``thicken(..., stiffness=...)``; None when the file has neither.
     """
 
     pattern: CreasePattern
     thickness: float | None
     frame_unit: str
+    stiffness: dict | None = None
 
 
 # ------------------------------------------------------------------- reading
@@ -144,7 +152,9 @@ def fold_file_from_dict(d, source: str = "<fold>") -> FoldFile:
         max_angles=None if max_angles is None else
         [DEFAULT_MAX_ANGLE_DEG if m is None else m for m in max_angles],
         faces=_faces(d, len(vertices), source), source=source)
-    return FoldFile(_build(args), _thickness(d, scale, source), unit)
+    pattern = _build(args)
+    return FoldFile(pattern, _thickness(d, scale, source), unit,
+                    _stiffness(d, n, args["faces"], source))
 
 
 def read_bytes(path, limit: int | None = None) -> bytes:
@@ -277,16 +287,44 @@ def _default_assignments(vertices, edges, source: str) -> list[str]:
 
 
 def _per_edge(d: dict, key: str, n_edges: int, source: str) -> list | None:
+    return _per_item(d, key, n_edges, "edge", source)
+
+
+def _per_item(d: dict, key: str, n: int, item: str, source: str) -> list | None:
+    """A per-edge or per-face list of finite numbers or nulls (None when absent)."""
     raw = d.get(key)
     if raw is None:
         return None
-    _check_length(raw, key, n_edges, source)
+    _check_length(raw, key, n, source, item)
     out = [None if x is None else _number(x) for x in raw]
     for i, (x, value) in enumerate(zip(raw, out)):
         if x is not None and value is None:
-            _fail(source, f"{key}[{i}] (edge {i}) must be a finite number or null, "
+            _fail(source, f"{key}[{i}] ({item} {i}) must be a finite number or null, "
                           f"got {_short(x)}")
     return out
+
+
+def _stiffness(d: dict, n_edges: int, faces, source: str) -> dict | None:
+    """Stiffness factors per edge and per face (null → 1); each must be > 0."""
+    out = {}
+    hinge = _per_edge(d, EDGE_STIFFNESS_KEY, n_edges, source)
+    if hinge is not None:
+        out["hinge"] = _positive_factors(hinge, EDGE_STIFFNESS_KEY, "edge", source)
+    if d.get(FACE_STIFFNESS_KEY) is not None:
+        if faces is None:
+            _fail(source, f"{FACE_STIFFNESS_KEY} needs faces_vertices in the file (it is "
+                          "given per face, in that order)")
+        panel = _per_item(d, FACE_STIFFNESS_KEY, len(faces), "face", source)
+        out["panel"] = _positive_factors(panel, FACE_STIFFNESS_KEY, "face", source)
+    return out or None
+
+
+def _positive_factors(values, key: str, item: str, source: str) -> np.ndarray:
+    for i, v in enumerate(values):
+        if v is not None and not v > 0:
+            _fail(source, f"{key}[{i}] ({item} {i}) must be a positive number or null, "
+                          f"got {_short(v)}")
+    return np.array([1.0 if v is None else float(v) for v in values])
 
 
 def _thickness(d: dict, scale: float, source: str) -> float | None:
@@ -344,12 +382,12 @@ def _required_list(d: dict, key: str, source: str) -> list:
     return d[key]
 
 
-def _check_length(raw, key: str, n_edges: int, source: str):
+def _check_length(raw, key: str, n: int, source: str, item: str = "edge"):
     if not isinstance(raw, ARRAY):
         _fail(source, f"{key} must be a list, got {type(raw).__name__}")
-    if len(raw) != n_edges:
-        _fail(source, f"{key} has {len(raw)} entries for {n_edges} edges "
-                      f"(edges_vertices); entry {min(len(raw), n_edges)} is the first mismatch")
+    if len(raw) != n:
+        _fail(source, f"{key} has {len(raw)} entries for {n} {item}s "
+                      f"({item}s_vertices); entry {min(len(raw), n)} is the first mismatch")
 
 
 def _number(x) -> float | None:
