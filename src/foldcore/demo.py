@@ -28,8 +28,8 @@ def headline(name: str, quantities: dict) -> str:
         return (f"θm/θv {one['theta_m_deg']:.1f}/{one['theta_v_deg']:.1f} and "
                 f"{two['theta_m_deg']:.1f}/{two['theta_v_deg']:.1f}")
     if name == "miura":
-        return (f"largest deviation from the rigid-fold angles "
-                f"{max(quantities['zigzag']['max_deviation_deg'], quantities['straight']['max_deviation_deg'])}°")
+        worst = max(quantities[k]["max_deviation_deg"] for k in ("zigzag", "straight"))
+        return f"largest deviation from the rigid-fold angles {worst}°"
     if name == "hinge-study":
         worst = max(r["angle_error_deg"] for r in quantities["runs"])
         return f"{len(quantities['runs'])} hinges, largest angle error {worst}°"

@@ -108,8 +108,8 @@ class Simulation:
         accelerated (safeguarded Anderson; L-BFGS with K as initial Hessian,
         :mod:`foldcore.accelerated`); their ``iterations`` are outer
         iterations (a refused Anderson point or a line-search trial costs one
-        more local step inside the same iteration). ``"rigid"``: rigid panels as rigid bodies, passive hinges
-        bent as one arc whose angle is a bounded unknown, Levenberg–Marquardt
+        more local step inside the same iteration). ``"rigid"``: rigid panels
+        as rigid bodies, passive hinges bent as one arc whose angle is a bounded unknown, Levenberg–Marquardt
         with geodesic acceleration (:mod:`foldcore.rigid_body`); needs a mesh
         of rigid panels and bending hinges. Its ``iterations`` are outer
         Levenberg–Marquardt iterations (rejected steps included) and its
@@ -477,8 +477,8 @@ class Simulation:
             return 1 if slots < SERIAL_BELOW_SLOTS else numba.config.NUMBA_NUM_THREADS
         if not (isinstance(threads, (int, np.integer)) and
                 1 <= threads <= numba.config.NUMBA_NUM_THREADS):
-            raise SimulationError(f"threads must be an integer in 1..{numba.config.NUMBA_NUM_THREADS},"
-                                  f" got {threads!r}")
+            raise SimulationError(f"threads must be an integer in "
+                                  f"1..{numba.config.NUMBA_NUM_THREADS}, got {threads!r}")
         return int(threads)
 
     def _checked_crease(self, e: int) -> int:
@@ -521,7 +521,8 @@ class Simulation:
             self._excess = np.zeros(len(self._hinges.group))
 
     def _update_stops(self, x: np.ndarray) -> None:
-        """Stiffen passive strips bent past their max angle at ``x``; release them once back inside."""
+        """Stiffen passive strips bent past their max angle at ``x``; release them once
+        back inside."""
         if self._stop_factor == 1.0 or self._hinges is None:
             return
         if not self._passive.any() and not self.stops.any():

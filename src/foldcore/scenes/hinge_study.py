@@ -1,4 +1,4 @@
-"""hinge-study — one hinge folded 180°: bend radius and angle error vs subdivisions (paper §6.1).
+"""hinge-study — one hinge folded 180°: bend radius and angle error vs k (paper §6.1).
 
 Provenance: the paper's hinge study — H = 0.5 mm, folded 180°, hinge width
 W = 0.8 mm (Eq. 7 with r ≈ 0: the inner face's vertices coalesce) against

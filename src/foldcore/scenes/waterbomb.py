@@ -42,8 +42,9 @@ def run(quick: bool = False, solver: str | None = None) -> SceneRun:
     solver = solver or "rigid"
     budget = (100 if quick else 400) if solver == "rigid" else (2_000 if quick else 40_000)
     quantities = {}
-    for position, major, major_angle in (("position_1", "M", TABLE_1["position_1"]["prototype"][0]),
-                                         ("position_2", "V", TABLE_1["position_2"]["prototype"][1])):
+    schedule = (("position_1", "M", TABLE_1["position_1"]["prototype"][0]),
+                ("position_2", "V", TABLE_1["position_2"]["prototype"][1]))
+    for position, major, major_angle in schedule:
         pattern = waterbomb(N_CREASES, radius=RADIUS, major=major, width=WIDTH,
                             major_angle=abs(major_angle))
         mesh = thicken(pattern, THICKNESS, subdivisions=SUBDIVISIONS)
