@@ -4,9 +4,9 @@ Tolerances: a single hinge actuated with exact arcs is compatible, so once
 converged (step ≤ 1e-10 × extent) each sub-strip's shape is its target and
 the strain matches the closed form to 1e-6 relative (the Eq. 9 estimate
 inverts the target exactly); Eq. 8 see the test. Fracture: the paper's map
-folds the strips gradually (~0.05° per iteration near 45°, measured), so the
-first failing iteration's angle lies within one step of the closed-form
-failure angle; 0.1° is the issue's bound.
+folds the strips gradually (45° in 730 iterations, 0.06° per iteration on
+average, measured), so the first failing iteration's angle lies within about
+one step of the closed-form failure angle; 0.1° is the issue's bound.
 """
 from __future__ import annotations
 
