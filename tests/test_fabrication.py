@@ -20,6 +20,7 @@ import json
 import sys
 import xml.etree.ElementTree as ET
 from functools import lru_cache
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -286,3 +287,33 @@ def test_atomic_path_leaves_nothing_on_error(tmp_path):
         assert tmp.endswith(".stl")
         open(tmp, "wb").write(b"whole")
     assert target.read_bytes() == b"whole" and len(list(tmp_path.iterdir())) == 1
+
+
+def test_stretch_hinges_join_the_sheet_and_bars_have_no_surface(tmp_path):
+    """A stretch strip is part of the sheet (one CUT outline of the whole area, one
+    HINGE outline); a 2-vertex element (examples/plugin_bar) adds no faces."""
+    import dataclasses
+
+    from foldcore.fabrication import surface_polygons
+    from foldcore.thickening import thicken
+
+    pattern = patterns.single_hinge(panel_length=10.0, depth=10.0, width=2.0)
+    mesh = thicken(pattern, 1.0, stretch={0: 0.3})
+    outlines = sheet_outlines(mesh)
+    assert len(outlines["CUT"]) == 1 and len(outlines["HINGE"]) == 1
+    assert _area(outlines["CUT"][0]) == pytest.approx(pattern.area(), rel=1e-12)
+    surf = surface_polygons(mesh)
+    assert surf.is_hinge.sum() > 0 and set(surf.group[surf.is_hinge]) == {"stretch_hinge"}
+    sys.path.insert(0, str(Path(__file__).parent.parent / "examples" / "plugin_bar"))
+    from bar import bar_group
+
+    with_bar = dataclasses.replace(mesh, groups={**mesh.groups,
+                                                 "bar": bar_group([[0, 5]], [1.0], [1.0])})
+    assert stl_bytes(with_bar, with_bar.rest_positions) == stl_bytes(mesh, mesh.rest_positions)
+
+
+def test_export_checks_every_destination_before_writing(result_fold, tmp_path):
+    svg = tmp_path / "ok.svg"
+    assert main(["export", str(result_fold), "--svg", str(svg),
+                 "--stl", str(tmp_path / "missing" / "x.stl")]) == 2
+    assert not svg.exists()

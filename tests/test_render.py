@@ -35,7 +35,9 @@ pytest.importorskip("pyvista")
 iio = pytest.importorskip("imageio.v3")
 
 from foldcore.render import (RenderError, colour_limits, hinge_values,  # noqa: E402
-                             parse_size, render_image, render_png, strip_bend_angles)
+                             parse_size, per_strip, render_image, render_png,
+                             strip_bend_angles)
+from foldcore.thickening import thicken  # noqa: E402
 
 DATA = Path(__file__).parent / "data"
 SIZE = (400, 300)
@@ -132,9 +134,18 @@ def test_scalar_colouring_with_colour_bar(tmp_path):
     solid = coloured[: int(0.8 * SIZE[1])].astype(int)
     assert _blue(solid).sum() > 100
     assert ((solid[..., 0] > solid[..., 2] + 30) & (solid[..., 0] > solid[..., 1] + 15)).sum() > 10
-    per_crease = render_image(pattern, mesh, result.positions, size=SIZE,
-                              scalars=result.fold_angles_deg, scalar_name="fold angle (deg)")
-    assert per_crease.shape == coloured.shape
+    spread = per_strip(mesh, result.fold_angles_deg)
+    np.testing.assert_array_equal(spread, result.fold_angles_deg[mesh.groups["bending_hinge"].source])
+
+
+def test_per_crease_values_are_spread_even_when_strips_equal_edges():
+    """7 sub-strips on a 7-edge pattern: a length test cannot tell per-crease from
+    per-strip values, so per_strip() does it explicitly (each strip its crease's)."""
+    pattern = patterns.single_hinge(angle=90.0, width=4.0)
+    mesh = thicken(pattern, 1.0, subdivisions=pattern.n_edges)
+    angles = np.full(pattern.n_edges, np.nan)
+    angles[0] = 90.0
+    np.testing.assert_array_equal(per_strip(mesh, angles), np.full(pattern.n_edges, 90.0))
 
 
 def test_top_view_of_the_flat_sheet_is_fitted_and_true_to_scale():
@@ -201,13 +212,12 @@ def test_strip_bend_angles_add_up_to_the_fold_angle():
     assert (bends[hinges.source == 3] < 0).all()          # crease 4 is the mountain
 
 
-def test_hinge_values_maps_per_crease_values_to_strips():
+def test_hinge_values_takes_per_strip_values_only():
     pattern, mesh, result = scene("d4")
-    strips = hinge_values(pattern, mesh, result.fold_angles_deg)
-    src = mesh.groups["bending_hinge"].source
-    assert strips == pytest.approx(result.fold_angles_deg[src])
     assert hinge_values(pattern, mesh, result.strip_angles_deg) == \
         pytest.approx(result.strip_angles_deg)
+    with pytest.raises(RenderError, match="per_strip"):
+        hinge_values(pattern, mesh, result.fold_angles_deg)    # E ≠ S here: refused
 
 
 def test_import_foldcore_stays_light():

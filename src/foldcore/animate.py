@@ -63,7 +63,7 @@ def check_output(path) -> str:
     Raises
     ------
     RenderError
-        Unknown suffix, or the package that encodes it is not installed.
+        Unknown suffix, or pyvista or the package that encodes it is not installed.
     ExportError
         The folder of ``path`` does not exist.
     """
@@ -83,6 +83,9 @@ def check_output(path) -> str:
     except ImportError:
         raise RenderError("animations need imageio and Pillow: pip install "
                           "'foldcore[render]'") from None
+    from .render import _pyvista
+
+    _pyvista()  # the frames are rendered with it: fail now, not after the sweep
     if suffix == ".mp4":
         try:
             import imageio_ffmpeg  # noqa: F401
@@ -144,8 +147,8 @@ def render_frames(pattern, mesh, positions, *, size=(640, 480), view="iso", scal
         Pixels, width × height.
     view : str or (3,) array
         As :func:`foldcore.render.render_png`.
-    scalars : sequence of (S,) or (E,) arrays, optional
-        One per frame (per sub-strip or per crease); the colour limits are
+    scalars : sequence of (S,) arrays, optional
+        One per frame, one value per sub-strip; the colour limits are
         those of all frames together unless ``clim`` is given.
     scalar_name : str
         Colour-bar title with unit.
@@ -253,12 +256,12 @@ def animate(sim, percents, path=None, *, fps: float = 10.0, size=(640, 480), vie
                          progress=progress)
     scalars, name, clim = None, "value", None
     if color_by != "assignment":   # signed angles: valley > 0 blue, mountain < 0 red
-        from .render import colour_limits, hinge_values
+        from .render import colour_limits, per_strip
 
-        scalars = [r.fold_angles_deg if color_by == "angle" else r.strip_angles_deg
-                   for r in results]
+        scalars = [per_strip(sim.mesh, r.fold_angles_deg) if color_by == "angle"
+                   else r.strip_angles_deg for r in results]
         name = "fold angle (deg)" if color_by == "angle" else "strip bend (deg)"
-        every = np.concatenate([hinge_values(sim.pattern, sim.mesh, s) for s in scalars])
+        every = np.concatenate(scalars)
         clim = colour_limits(every, signed=True)
     frames = render_frames(sim.pattern, sim.mesh, [r.positions for r in results], size=size,
                            view=view, scalars=scalars, scalar_name=name, clim=clim,

@@ -259,7 +259,7 @@ def render_result(args) -> int:
     """
     from .fabrication import read_result
     from .measure import fold_angles
-    from .render import colour_limits, render_png, strip_bend_angles
+    from .render import colour_limits, per_strip, render_png, strip_bend_angles
 
     res = read_result(args.result, args.hinge_width, args.subdivisions)
     options = {}
@@ -273,8 +273,8 @@ def render_result(args) -> int:
                        cmap="viridis", scalar_name="surface tension strain")
     elif args.color_by != "none":   # signed angles, valley > 0: blue, mountain < 0: red
         angle = args.color_by == "angle"
-        values = fold_angles(res.pattern, res.mesh, res.positions) if angle \
-            else strip_bend_angles(res.mesh, res.positions)
+        values = per_strip(res.mesh, fold_angles(res.pattern, res.mesh, res.positions)) \
+            if angle else strip_bend_angles(res.mesh, res.positions)
         options = dict(scalars=values, clim=colour_limits(values, signed=True), cmap="RdBu",
                        scalar_name="fold angle (deg)" if angle else "strip bend (deg)")
     render_png(res.pattern, res.mesh, res.positions, args.output, size=args.size,

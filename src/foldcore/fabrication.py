@@ -113,8 +113,11 @@ class SurfaceFaces:
         Element group of the prism each face belongs to.
     element : (F,) int64
         Index of that prism in its group.
+    source : (F,) int64
+        The pattern item that prism came from (its group's ``source``: a face
+        for panels, an edge for hinges).
     is_hinge : (F,) bool
-        The prism is a hinge sub-strip (``bending_hinge``).
+        The prism is not a panel (a bending or stretch hinge strip, …).
     is_cap : (F,) bool
         Top or bottom face (planar in the footprint), else a side quad.
     """
@@ -122,6 +125,7 @@ class SurfaceFaces:
     loops: list
     group: np.ndarray
     element: np.ndarray
+    source: np.ndarray
     is_hinge: np.ndarray
     is_cap: np.ndarray
 
@@ -137,6 +141,12 @@ def _prism_faces(ids: np.ndarray):
         yield np.array([top[k], top[j], bot[j], bot[k]]), False
 
 
+def _is_prism_group(group) -> bool:
+    """Every element has an even number (≥ 6) of vertex ids: top loop then bottom loop."""
+    sizes = np.diff(group.indptr)
+    return bool(len(sizes) and (sizes >= 6).all() and (sizes % 2 == 0).all())
+
+
 def surface_polygons(mesh) -> SurfaceFaces:
     """The outer surface of ``mesh``: every prism face not shared with another prism.
 
@@ -146,6 +156,8 @@ def surface_polygons(mesh) -> SurfaceFaces:
     """
     faces = []
     for name, g in mesh.groups.items():
+        if not _is_prism_group(g):
+            continue  # e.g. a 2-vertex bar (examples/plugin_bar): no faces of its own
         for i in range(len(g)):
             for loop, cap in _prism_faces(g.indices[g.slots(i)]):
                 faces.append((loop, name, i, cap))
@@ -157,7 +169,9 @@ def surface_polygons(mesh) -> SurfaceFaces:
     return SurfaceFaces(loops=[f[0].astype(np.int64) for f in kept],
                         group=np.array([f[1] for f in kept], dtype=object),
                         element=np.array([f[2] for f in kept], dtype=np.int64),
-                        is_hinge=np.array([f[1] == "bending_hinge" for f in kept], dtype=bool),
+                        source=np.array([mesh.groups[f[1]].source[f[2]] for f in kept],
+                                        dtype=np.int64),
+                        is_hinge=np.array([f[1] != mesh.panel_group for f in kept], dtype=bool),
                         is_cap=np.array([f[3] for f in kept], dtype=bool))
 
 
@@ -293,6 +307,9 @@ def sheet_outlines(mesh) -> dict:
     panels = mesh.groups[mesh.panel_group]
     panel_loops = [pts[_top(panels, i)] for i in range(len(panels))]
     hinge_loops = [pts[_strip_outline(mesh, e)] for e in sorted(mesh.strips_of_crease)]
+    stretch = mesh.groups.get("stretch_hinge")
+    if stretch is not None:  # one strip per crease, its top loop is its outline
+        hinge_loops += [pts[_top(stretch, i)] for i in range(len(stretch))]
     polygons = [shapely.Polygon(p) for p in panel_loops + hinge_loops]
     union = shapely.union_all(polygons)
     cut = []
@@ -585,6 +602,9 @@ def export(result: ResultFile, svg=None, dxf=None, stl=None) -> list:
     """
     if not (svg or dxf or stl):
         raise ExportError("nothing to export: give --svg, --dxf and/or --stl")
+    for path in (svg, dxf, stl):
+        if path:
+            _check_folder(os.fspath(path))  # every destination before any write
     contents = []
     if svg or dxf:
         result.check_footprint()

@@ -8,7 +8,8 @@ What a picture shows
 * Panels light grey; hinge sub-strips coloured by their crease's assignment:
   valley blue, mountain red, unassigned amber, flat grey, with a legend.
 * Or, with ``scalars``, hinge sub-strips coloured by one value per sub-strip
-  or per crease (fold angle in degrees, strain, …) through a colour map, with
+  (per-crease values spread with :func:`per_strip`: fold angle in degrees,
+  strain, …) through a colour map, with
   a labelled colour bar; panels stay grey. Signed values get the diverging map
   ``RdBu`` with symmetric limits, so valleys (> 0) are blue and mountains red
   as in the assignment colours.
@@ -111,25 +112,27 @@ def view_vectors(view) -> tuple[np.ndarray, np.ndarray]:
 
 # ---------------------------------------------------------------- scalars
 def hinge_values(pattern, mesh, scalars) -> np.ndarray:
-    """One value per hinge sub-strip, (S,) float, from per-strip or per-crease values.
+    """Validated per-strip values, (S,) float, S = ``len(mesh.groups["bending_hinge"])``.
 
-    Parameters
-    ----------
-    scalars : (S,) or (E,) array_like
-        S = number of hinge sub-strips (``len(mesh.groups["bending_hinge"])``,
-        e.g. ``Result.strip_angles_deg``), E = number of pattern edges (e.g.
-        ``Result.fold_angles_deg``); per-crease values are repeated on the
-        crease's sub-strips. When S == E the values are taken per strip.
+    Per-crease values (e.g. ``Result.fold_angles_deg``) must be spread first
+    with :func:`per_strip`: the length alone cannot tell them apart (S may
+    equal the number of edges).
     """
     hinges = mesh.groups.get("bending_hinge")
     n_strips = 0 if hinges is None else len(hinges)
     values = np.asarray(scalars, dtype=float).ravel()
-    if values.shape == (n_strips,):
-        return values.copy()
-    if values.shape == (pattern.n_edges,) and hinges is not None:
-        return values[hinges.source]
-    raise RenderError(f"scalars must have one value per hinge sub-strip ({n_strips}) or per "
-                      f"pattern edge ({pattern.n_edges}), got {values.size}")
+    if values.shape != (n_strips,):
+        raise RenderError(f"scalars must have one value per hinge sub-strip ({n_strips}), "
+                          f"got {values.size}; spread per-crease values with per_strip()")
+    return values.copy()
+
+
+def per_strip(mesh, crease_values) -> np.ndarray:
+    """(S,) per-sub-strip copy of per-crease values (E,) (each strip takes its crease's)."""
+    hinges = mesh.groups.get("bending_hinge")
+    if hinges is None:
+        return np.zeros(0)
+    return np.asarray(crease_values, dtype=float)[hinges.source]
 
 
 def colour_limits(values, signed: bool | None = None) -> tuple[float, float]:
@@ -213,6 +216,8 @@ def _surface_polydata(mesh, positions):
         poly = pv.PolyData(x.copy(), np.column_stack([np.full(len(chosen), 3),
                                                       tris[chosen]]).ravel())
         poly.cell_data["strip"] = surf.element[face[chosen]]
+        poly.cell_data["edge"] = surf.source[face[chosen]]
+        poly.cell_data["bending"] = (surf.group[face[chosen]] == "bending_hinge").astype(np.uint8)
         out.append(poly)
     edges = surface_edges(surf)
     lines = pv.PolyData(x.copy(), lines=np.column_stack([np.full(len(edges), 2),
@@ -266,8 +271,9 @@ class Renderer:
     view : str or (3,) array
         Camera preset (``iso``, ``top``, ``front``, ``side``) or direction from
         the solid to the camera; see the module docstring.
-    scalars : (S,) or (E,) array_like, optional
-        Colour hinge sub-strips by these values (see :func:`hinge_values`);
+    scalars : (S,) array_like, optional
+        Colour hinge sub-strips by these values, one per sub-strip (spread
+        per-crease values with :func:`per_strip`);
         None: colour by assignment (M/V) with a legend.
     scalar_name : str
         Colour-bar title, with its unit, e.g. ``"fold angle (deg)"``.
@@ -322,8 +328,7 @@ class Renderer:
     def _add_assignment_hinges(self, legend: bool):
         if self.hinges is None:
             return
-        group = self.mesh.groups["bending_hinge"]
-        kinds = np.asarray(self.pattern.assignments)[group.source[self.hinges.cell_data["strip"]]]
+        kinds = np.asarray(self.pattern.assignments)[self.hinges.cell_data["edge"]]
         rgb = np.array([HINGE_COLOURS.get(k, HINGE_COLOURS["U"]) for k in kinds])
         self.hinges.cell_data["colour"] = (255 * rgb).astype(np.uint8)
         _behind_lines(self.plotter.add_mesh(self.hinges, scalars="colour", rgb=True))
@@ -345,7 +350,7 @@ class Renderer:
         if self.hinges is None:
             return
         self.clim = tuple(float(c) for c in (clim or colour_limits(strips)))
-        self.hinges.cell_data["value"] = strips[self.hinges.cell_data["strip"]]
+        self.hinges.cell_data["value"] = self._strip_cells(strips)
         bar = dict(title=name, color="black", vertical=False, position_x=0.2,
                    position_y=0.03, width=0.6, height=0.09, n_labels=5, fmt="%.3g",
                    title_font_size=self._font(18), label_font_size=self._font(16),
@@ -354,6 +359,13 @@ class Renderer:
             self.hinges, scalars="value", cmap=cmap or default_cmap(self.clim), clim=self.clim,
             nan_color=(0.5, 0.5, 0.5), scalar_bar_args=bar))
         self._box[2] = _BAR_STRIP
+
+    def _strip_cells(self, strips: np.ndarray) -> np.ndarray:
+        """Per-cell values of the hinge surface: bending sub-strips take theirs, other
+        hinge-like prisms (stretch hinges) NaN."""
+        bending = self.hinges.cell_data["bending"].astype(bool)
+        return np.where(bending, strips[np.where(bending, self.hinges.cell_data["strip"], 0)]
+                        if len(strips) else np.nan, np.nan)
 
     def _add_title(self, title):
         if title is None:
@@ -380,7 +392,7 @@ class Renderer:
                 poly.points = x.copy()
         if scalars is not None and self.hinges is not None and "value" in self.hinges.cell_data:
             strips = hinge_values(self.pattern, self.mesh, scalars)
-            self.hinges.cell_data["value"] = strips[self.hinges.cell_data["strip"]]
+            self.hinges.cell_data["value"] = self._strip_cells(strips)
         if title is not None and self._title is not None:
             self._title.SetInput(str(title))   # a vtkTextActor: fixed size in pixels
 
@@ -450,8 +462,8 @@ def render_png(pattern, mesh, positions, path, size=(1024, 768), view="iso", *, 
     fit_points : (M, 3) array, optional
         Fit to these points instead (e.g. every frame of an animation).
     **options
-        :class:`Renderer` keywords: ``scalars`` (per sub-strip or per crease,
-        e.g. ``result.strip_angles_deg``), ``scalar_name`` (colour-bar title
+        :class:`Renderer` keywords: ``scalars`` (one per sub-strip, e.g.
+        ``result.strip_angles_deg`` or ``per_strip(mesh, result.fold_angles_deg)``), ``scalar_name`` (colour-bar title
         with unit), ``cmap``, ``clim``, ``legend``, ``padding``, ``title``.
 
     Examples
