@@ -34,13 +34,14 @@ from __future__ import annotations
 
 import io
 import os
-import secrets
-from contextlib import contextmanager, suppress
+from contextlib import contextmanager
 from dataclasses import dataclass
 
 import numpy as np
 
 from .errors import FoldcoreError, PatternError
+from .io.fold import atomic_path as io_atomic_path
+from .io.fold import atomic_write
 
 LAYERS = {"CUT": {"dxf_colour": 1, "svg": "#ff0000"},     # red
           "PANEL": {"dxf_colour": 5, "svg": "#0000ff"},   # blue
@@ -61,26 +62,14 @@ class ExportError(FoldcoreError, ValueError):
 # ------------------------------------------------------------------- writing
 @contextmanager
 def atomic_path(path, suffix: str | None = None):
-    """A temporary path (same folder) that is renamed to ``path`` if the block succeeds.
-
-    For writers that take a file name (pyvista, imageio) or write bytes. The
-    temporary name ends with ``suffix`` (default: ``path``'s own), so writers
-    that choose a format from the name still do. On any exception the
-    temporary file is removed and ``path`` is left as it was.
-    """
+    """:func:`foldcore.io.fold.atomic_path` after checking the folder exists
+    (:class:`ExportError` naming it); the temporary name ends with ``suffix``
+    (default: ``path``'s own suffix), so format-by-name writers still work."""
     target = os.fspath(path)
-    folder, name = _check_folder(target)
+    _, name = _check_folder(target)
     suffix = os.path.splitext(name)[1] if suffix is None else suffix
-    tmp = os.path.join(folder, f".{name[:50]}.{os.getpid()}.{secrets.token_hex(4)}.tmp{suffix}")
-    try:
+    with io_atomic_path(target, suffix) as tmp:
         yield tmp
-        if not os.path.exists(tmp):
-            raise ExportError(f"{target}: the writer produced no file")
-        os.replace(tmp, target)
-    except BaseException:
-        with suppress(OSError):
-            os.unlink(tmp)
-        raise
 
 
 def _check_folder(target: str) -> tuple[str, str]:
@@ -93,11 +82,9 @@ def _check_folder(target: str) -> tuple[str, str]:
 
 def write_bytes(path, data: bytes) -> None:
     """Write ``data`` to ``path`` atomically (temporary file, fsync, rename)."""
-    with atomic_path(path) as tmp:
-        with open(tmp, "xb") as fh:
-            fh.write(data)
-            fh.flush()
-            os.fsync(fh.fileno())
+    _check_folder(os.fspath(path))
+    with atomic_write(path, binary=True) as fh:
+        fh.write(data)
 
 
 # ------------------------------------------------------------------- surface
@@ -422,8 +409,6 @@ def write_dxf(path, mesh) -> None:
 
 
 def _write_text(path, text: str) -> None:
-    from .io.fold import atomic_write
-
     _check_folder(os.fspath(path))
     with atomic_write(path) as fh:
         fh.write(text)

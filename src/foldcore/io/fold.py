@@ -31,6 +31,7 @@ offending item; files above :data:`MAX_FILE_BYTES` are refused unread.
 """
 from __future__ import annotations
 
+import errno
 import json
 import os
 import secrets
@@ -468,28 +469,40 @@ def write_fold(path, pattern: CreasePattern, achieved_angles=None, frames=None,
 
 
 @contextmanager
-def atomic_write(path):
-    """Open a text file for writing that appears at ``path`` only when complete.
+def atomic_path(path, suffix: str = ""):
+    """A temporary path (same folder) that is renamed to ``path`` if the block succeeds.
 
-    Writes a temporary file in the same directory, fsyncs it and renames it over
-    ``path`` (:func:`os.replace`); on any exception the temporary file is removed
-    and ``path`` is left as it was.
+    For writers that take a file name (pyvista, imageio) or are given an open
+    file (:func:`atomic_write`). The temporary name is a prefix of the target's
+    (it must fit NAME_MAX too) and ends in ``.tmp`` + ``suffix``, so writers
+    that choose a format from the name still do. On any exception the
+    temporary file is removed and ``path`` is left as it was.
     """
     target = os.fspath(path)
     folder, name = os.path.split(os.path.abspath(target))
-    # a prefix of the name: the temporary name must fit NAME_MAX (255 bytes) too
-    tmp = os.path.join(folder, f".{name[:50]}.{os.getpid()}.{secrets.token_hex(4)}.tmp")
-    fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666)
+    tmp = os.path.join(folder, f".{name[:50]}.{os.getpid()}.{secrets.token_hex(4)}.tmp{suffix}")
     try:
-        with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as fh:
-            yield fh
-            fh.flush()
-            os.fsync(fh.fileno())
+        yield tmp
+        if not os.path.exists(tmp):
+            raise OSError(errno.ENOENT, "the writer produced no file", target)
         os.replace(tmp, target)
     except BaseException:
         with suppress(OSError):
             os.unlink(tmp)
         raise
+
+
+@contextmanager
+def atomic_write(path, binary: bool = False):
+    """Open a file for writing (text UTF-8, or bytes) that appears at ``path`` only when
+    complete: written to a temporary file, fsynced, renamed over ``path``
+    (:func:`atomic_path`)."""
+    with atomic_path(path) as tmp:
+        mode = {"mode": "xb"} if binary else {"mode": "x", "encoding": "utf-8", "newline": "\n"}
+        with open(tmp, **mode) as fh:
+            yield fh
+            fh.flush()
+            os.fsync(fh.fileno())
 
 
 def _nullable(values: np.ndarray) -> list:
