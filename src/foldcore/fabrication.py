@@ -42,6 +42,7 @@ import numpy as np
 from .errors import FoldcoreError, PatternError
 from .io.fold import atomic_path as io_atomic_path
 from .io.fold import atomic_write
+from .mesh import SurfaceFaces, surface_polygons  # noqa: F401  (part of this API)
 
 LAYERS = {"CUT": {"dxf_colour": 1, "svg": "#ff0000"},     # red
           "PANEL": {"dxf_colour": 5, "svg": "#0000ff"},   # blue
@@ -88,78 +89,6 @@ def write_bytes(path, data: bytes) -> None:
 
 
 # ------------------------------------------------------------------- surface
-@dataclass(frozen=True)
-class SurfaceFaces:
-    """Outer-surface polygons of a ThickMesh (faces not shared by two prisms).
-
-    Attributes
-    ----------
-    loops : list of (n,) int64
-        Vertex ids of each face, counter-clockwise seen from outside.
-    group : (F,) str
-        Element group of the prism each face belongs to.
-    element : (F,) int64
-        Index of that prism in its group.
-    source : (F,) int64
-        The pattern item that prism came from (its group's ``source``: a face
-        for panels, an edge for hinges).
-    is_hinge : (F,) bool
-        The prism is not a panel (a bending or stretch hinge strip, …).
-    is_cap : (F,) bool
-        Top or bottom face (planar in the footprint), else a side quad.
-    """
-
-    loops: list
-    group: np.ndarray
-    element: np.ndarray
-    source: np.ndarray
-    is_hinge: np.ndarray
-    is_cap: np.ndarray
-
-
-def _prism_faces(ids: np.ndarray):
-    """(loop, is_cap) of a prism's faces: top, bottom, side quads (as ThickMesh.prism_faces)."""
-    n = len(ids) // 2
-    top, bot = ids[:n], ids[n:]
-    yield top, True
-    yield bot[::-1], True
-    for j in range(n):
-        k = (j + 1) % n
-        yield np.array([top[k], top[j], bot[j], bot[k]]), False
-
-
-def _is_prism_group(group) -> bool:
-    """Every element has an even number (≥ 6) of vertex ids: top loop then bottom loop."""
-    sizes = np.diff(group.indptr)
-    return bool(len(sizes) and (sizes >= 6).all() and (sizes % 2 == 0).all())
-
-
-def surface_polygons(mesh) -> SurfaceFaces:
-    """The outer surface of ``mesh``: every prism face not shared with another prism.
-
-    Conforming neighbours share whole faces, so a face listed twice is inside
-    (the rule of :func:`foldcore.mesh.surface_faces`, here with the prism of
-    each face).
-    """
-    faces = []
-    for name, g in mesh.groups.items():
-        if not _is_prism_group(g):
-            continue  # e.g. a 2-vertex bar (examples/plugin_bar): no faces of its own
-        for i in range(len(g)):
-            for loop, cap in _prism_faces(g.indices[g.slots(i)]):
-                faces.append((loop, name, i, cap))
-    count: dict = {}
-    keys = [tuple(sorted(loop.tolist())) for loop, *_ in faces]
-    for key in keys:
-        count[key] = count.get(key, 0) + 1
-    kept = [f for f, key in zip(faces, keys) if count[key] == 1]
-    return SurfaceFaces(loops=[f[0].astype(np.int64) for f in kept],
-                        group=np.array([f[1] for f in kept], dtype=object),
-                        element=np.array([f[2] for f in kept], dtype=np.int64),
-                        source=np.array([mesh.groups[f[1]].source[f[2]] for f in kept],
-                                        dtype=np.int64),
-                        is_hinge=np.array([f[1] != mesh.panel_group for f in kept], dtype=bool),
-                        is_cap=np.array([f[3] for f in kept], dtype=bool))
 
 
 def triangulate_polygon(xy) -> np.ndarray:

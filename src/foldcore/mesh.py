@@ -111,22 +111,18 @@ class ThickMesh:
         Returns
         -------
         faces : list of (n,) int arrays
-            Vertex loops (top, bottom and side quads of every prism).
+            Vertex loops (top, bottom and side quads of every prism; groups
+            whose elements are not prisms, e.g. 2-vertex bars, have none).
         element_kind : list of str
             Group name of the prism each face belongs to.
         """
         faces, kinds = [], []
         for name, g in self.groups.items():
+            if not is_prism_group(g):
+                continue
             for i in range(len(g)):
-                ids = g.indices[g.slots(i)]
-                n = len(ids) // 2
-                top, bot = ids[:n], ids[n:]
-                faces.append(top)
-                faces.append(bot[::-1])
-                kinds += [name, name]
-                for j in range(n):
-                    k = (j + 1) % n
-                    faces.append(np.array([top[k], top[j], bot[j], bot[k]]))
+                for loop, _ in prism_face_loops(g.indices[g.slots(i)]):
+                    faces.append(loop)
                     kinds.append(name)
         return faces, kinds
 
@@ -155,13 +151,81 @@ class ThickMesh:
 
 
 def surface_faces(mesh: ThickMesh) -> list:
-    """Outer surface of the prism mesh: prism faces not shared by two prisms.
+    """Outer surface of the prism mesh: prism faces not shared by two prisms."""
+    return surface_polygons(mesh).loops
 
-    Conforming neighbours share whole faces, so a face listed twice is inside.
+
+@dataclass(frozen=True)
+class SurfaceFaces:
+    """Outer-surface polygons of a ThickMesh (faces not shared by two prisms).
+
+    Attributes
+    ----------
+    loops : list of (n,) int64
+        Vertex ids of each face, counter-clockwise seen from outside.
+    group : (F,) str
+        Element group of the prism each face belongs to.
+    element : (F,) int64
+        Index of that prism in its group.
+    source : (F,) int64
+        The pattern item that prism came from (its group's ``source``: a face
+        for panels, an edge for hinges).
+    is_hinge : (F,) bool
+        The prism is not a panel (a bending or stretch hinge strip, …).
+    is_cap : (F,) bool
+        Top or bottom face (planar in the footprint), else a side quad.
     """
-    faces, _ = mesh.prism_faces()
+
+    loops: list
+    group: np.ndarray
+    element: np.ndarray
+    source: np.ndarray
+    is_hinge: np.ndarray
+    is_cap: np.ndarray
+
+
+def prism_face_loops(ids: np.ndarray):
+    """(loop, is_cap) of a prism's faces: top, bottom (reversed), side quads, outward.
+
+    ``ids`` (2n,): the top loop (counter-clockwise seen from +z) then the bottom.
+    """
+    n = len(ids) // 2
+    top, bot = ids[:n], ids[n:]
+    yield top, True
+    yield bot[::-1], True
+    for j in range(n):
+        k = (j + 1) % n
+        yield np.array([top[k], top[j], bot[j], bot[k]]), False
+
+
+def is_prism_group(group) -> bool:
+    """Every element has an even number (≥ 6) of vertex ids: top loop then bottom loop."""
+    sizes = np.diff(group.indptr)
+    return bool(len(sizes) and (sizes >= 6).all() and (sizes % 2 == 0).all())
+
+
+def surface_polygons(mesh) -> SurfaceFaces:
+    """The outer surface of ``mesh``: every prism face not shared with another prism.
+
+    Conforming neighbours share whole faces, so a face listed twice is inside
+    (:func:`surface_faces` is its ``loops``).
+    """
+    faces = []
+    for name, g in mesh.groups.items():
+        if not is_prism_group(g):
+            continue  # e.g. a 2-vertex bar (examples/plugin_bar): no faces of its own
+        for i in range(len(g)):
+            for loop, cap in prism_face_loops(g.indices[g.slots(i)]):
+                faces.append((loop, name, i, cap))
     count: dict = {}
-    for f in faces:
-        key = tuple(sorted(int(i) for i in f))
+    keys = [tuple(sorted(loop.tolist())) for loop, *_ in faces]
+    for key in keys:
         count[key] = count.get(key, 0) + 1
-    return [f for f in faces if count[tuple(sorted(int(i) for i in f))] == 1]
+    kept = [f for f, key in zip(faces, keys) if count[key] == 1]
+    return SurfaceFaces(loops=[f[0].astype(np.int64) for f in kept],
+                        group=np.array([f[1] for f in kept], dtype=object),
+                        element=np.array([f[2] for f in kept], dtype=np.int64),
+                        source=np.array([mesh.groups[f[1]].source[f[2]] for f in kept],
+                                        dtype=np.int64),
+                        is_hinge=np.array([f[1] != mesh.panel_group for f in kept], dtype=bool),
+                        is_cap=np.array([f[3] for f in kept], dtype=bool))
