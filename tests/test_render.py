@@ -176,7 +176,7 @@ def test_views_differ_and_bad_options_are_refused(tmp_path):
     out = tmp_path / "x.png"
     with pytest.raises(RenderError, match="positions"):
         render_png(pattern, mesh, result.positions[:5], out)
-    assert list(tmp_path.iterdir()) == []            # nothing written, no temp file
+    assert list(tmp_path.iterdir()) == []            # refused before anything is written
 
 
 def test_render_png_keeps_its_positional_signature(tmp_path):
@@ -350,7 +350,6 @@ def test_mp4_needs_imageio_ffmpeg_and_says_so(tmp_path, monkeypatch):
         check_output(tmp_path / "b.mp4")
     with pytest.raises(RenderError, match=".gif or .mp4"):
         check_output(tmp_path / "b.avi")
-    assert not (tmp_path / "b.mp4").exists()
 
 
 def _has(module: str) -> bool:

@@ -25,10 +25,10 @@ looking at the solid from:
 * ``side``: +x, looking along −x, y right, z up;
 * or any (3,) direction vector (from the solid toward the camera).
 
-The camera is fitted to the solid (``fit=True``, default): the projected
-bounding box fills the free part of the picture (the colour bar, legend and
-title strips are kept clear) with ``padding`` around it. ``fit_points`` fits
-to other points instead (an animation fits once to every frame).
+The orthographic camera is fitted to the solid: the projected bounding box
+fills the free part of the picture (the colour bar, legend and title strips
+are kept clear) with ``padding`` around it (an animation, :class:`Renderer`,
+fits once to every frame with :meth:`Renderer.fit`).
 """
 from __future__ import annotations
 
@@ -428,22 +428,21 @@ class Renderer:
 
 
 # ---------------------------------------------------------------- one picture
-def render_image(pattern, mesh, positions, size=(1024, 768), view="iso", *, fit=True,
-                 fit_points=None, **options) -> np.ndarray:
+def render_image(pattern, mesh, positions, size=(1024, 768), view="iso",
+                 **options) -> np.ndarray:
     """Render the thick mesh at ``positions`` (N, 3) mm; returns (height, width, 3) uint8.
 
     ``options`` are those of :class:`Renderer` (``scalars``, ``scalar_name``,
-    ``cmap``, ``clim``, ``legend``, ``padding``, ``title``). ``fit=False``
-    keeps pyvista's own camera reset (perspective) for the view direction.
+    ``cmap``, ``clim``, ``legend``, ``padding``, ``title``).
     """
     with Renderer(pattern, mesh, size, view, **options) as r:
         r.update(positions)
-        _place_camera(r, fit, fit_points)
+        r.fit()
         return r.image()
 
 
-def render_png(pattern, mesh, positions, path, size=(1024, 768), view="iso", *, fit=True,
-               fit_points=None, **options) -> None:
+def render_png(pattern, mesh, positions, path, size=(1024, 768), view="iso",
+               **options) -> None:
     """Render the thick mesh at ``positions`` (N, 3) mm to a PNG file, offscreen, atomically.
 
     Parameters
@@ -457,14 +456,11 @@ def render_png(pattern, mesh, positions, path, size=(1024, 768), view="iso", *, 
         Width, height in pixels (default 1024×768).
     view : {"iso", "top", "front", "side"} or (3,) array
         Camera preset or direction (module docstring).
-    fit : bool
-        Fit the orthographic camera tightly to the solid (default).
-    fit_points : (M, 3) array, optional
-        Fit to these points instead (e.g. every frame of an animation).
     **options
         :class:`Renderer` keywords: ``scalars`` (one per sub-strip, e.g.
-        ``result.strip_angles_deg`` or ``per_strip(mesh, result.fold_angles_deg)``), ``scalar_name`` (colour-bar title
-        with unit), ``cmap``, ``clim``, ``legend``, ``padding``, ``title``.
+        ``result.strip_angles_deg`` or ``per_strip(mesh, result.fold_angles_deg)``),
+        ``scalar_name`` (colour-bar title with unit), ``cmap``, ``clim``,
+        ``legend``, ``padding``, ``title``.
 
     Examples
     --------
@@ -474,18 +470,8 @@ def render_png(pattern, mesh, positions, path, size=(1024, 768), view="iso", *, 
     """
     with Renderer(pattern, mesh, size, view, **options) as r:
         r.update(positions)
-        _place_camera(r, fit, fit_points)
+        r.fit()
         r.save(path)
-
-
-def _place_camera(r: Renderer, fit: bool, fit_points) -> None:
-    if fit:
-        r.fit(fit_points)
-        return
-    r.plotter.camera.position = tuple(r.direction)
-    r.plotter.camera.focal_point = (0.0, 0.0, 0.0)
-    r.plotter.camera.up = tuple(r.up)
-    r.plotter.reset_camera()
 
 
 def _pyvista():
