@@ -91,6 +91,22 @@ def test_hinge_study_radius(runs):
     assert gap[8] < gap[4]
 
 
+def test_groove_bar_hinge_stops_at_its_limit_then_the_panels_bend(runs):
+    """Up to 90° the pull is exactly reachable by the hinge (exact-arc kinematics), so
+    the panels stay rigid (deviation ≤ 1e-6 of their length, the issue's bound) and
+    the hinge follows the pull; beyond it the hinge's stop holds it at 90° ± 0.5°
+    (its weight ×1000, finite) and the panels' bend grows with every step."""
+    steps = runs["groove-bar"].quantities["steps"]
+    before = [s for s in steps if s["pull_deg"] <= 90]
+    after = [s for s in steps if s["pull_deg"] > 90]
+    for s in before:
+        assert s["panel_deviation"] <= 1e-6
+        assert abs(s["hinge_angle_deg"] - s["pull_deg"]) < 0.05
+    assert all(abs(s["hinge_angle_deg"] - 90.0) <= 0.5 for s in after)
+    bends = [s["panel_bend_deg"] for s in after]
+    assert bends[0] > 0 and all(b > a for a, b in zip(bends, bends[1:]))
+
+
 def test_scene_outputs_hold_the_quantities(runs, tmp_path):
     written = scenes.write(runs["waterbomb"], tmp_path, png=False)
     assert {p.suffix for p in written} == {".fold", ".json"}

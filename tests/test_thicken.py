@@ -838,3 +838,25 @@ def test_invariants_random_vertices(case):
     pattern, k, H = case
     mesh = thicken(pattern, H, subdivisions=k)
     check_mesh(pattern, mesh, H)
+
+
+def test_elastic_panels_are_cells_along_the_bar():
+    """A bar face split into n cells: n prisms of the panel group, total volume kept,
+    the cell next to the crease measures the fold; refusals name the face."""
+    pattern = patterns.single_hinge(panel_length=40.0, depth=10.0, width=3.0)
+    plain = thicken(pattern, 2.0, subdivisions=2)
+    mesh = thicken(pattern, 2.0, subdivisions=2, elastic={1: 5}, stiffness={"panel": [1.0, 3.0]})
+    panels = mesh.groups["rigid_panel"]
+    assert len(panels) == 1 + 5 and list(panels.source) == [0, 1, 1, 1, 1, 1]
+    assert panels.volumes.sum() == pytest.approx(plain.groups["rigid_panel"].volumes.sum())
+    np.testing.assert_allclose(panels.weights[1:], 3.0 * panels.volumes[1:])
+    first = mesh.points[panels.indices[panels.slots(int(mesh.panel_of_face[1]))][:4]]
+    assert first[:, 0].min() == pytest.approx(1.5)          # it touches the hinge (W/2)
+    assert mesh.n_vertices == plain.n_vertices + 2 * 2 * 4   # 4 cut lines, 2 points, 2 layers
+    with pytest.raises(MeshError, match="face 1: the number of cells"):
+        thicken(pattern, 2.0, elastic={1: 0})
+    with pytest.raises(MeshError, match="face 7 does not exist"):
+        thicken(pattern, 2.0, elastic={7: 3})
+    vertex = patterns.degree4_vertex(radius=20.0, widths=[1.0] * 4)
+    with pytest.raises(MeshError, match="only quadrilateral faces with exactly one crease"):
+        thicken(vertex, 1.0, elastic={0: 3})

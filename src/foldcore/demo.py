@@ -15,7 +15,7 @@ import sys
 import time
 from pathlib import Path
 
-DEMO_SCENES = ("d4v", "waterbomb", "miura", "hinge-study")
+DEMO_SCENES = ("d4v", "waterbomb", "miura", "hinge-study", "groove-bar")
 
 
 def headline(name: str, quantities: dict) -> str:
@@ -30,6 +30,10 @@ def headline(name: str, quantities: dict) -> str:
     if name == "miura":
         worst = max(quantities[k]["max_deviation_deg"] for k in ("zigzag", "straight"))
         return f"largest deviation from the rigid-fold angles {worst}°"
+    if name == "groove-bar":
+        last = quantities["steps"][-1]
+        return (f"pulled to {last['pull_deg']}°: hinge {last['hinge_angle_deg']}°, "
+                f"panel bent {last['panel_bend_deg']}°")
     if name == "hinge-study":
         worst = max(r["angle_error_deg"] for r in quantities["runs"])
         return f"{len(quantities['runs'])} hinges, largest angle error {worst}°"

@@ -199,6 +199,7 @@ class Simulation:
             new[e] = self._checked_angle(e, angle)
         self._fold_targets = new
         self._apply_fold_targets()
+        self._targets_changed()
 
     def set_stretch_ratios(self, ratios: dict) -> None:
         """Actuate stretch hinges (§6.3): ``{edge id: λ or None}``.
@@ -219,6 +220,7 @@ class Simulation:
                 raise SimulationError(f"edge {e}: stretch ratio must be a positive number, "
                                       f"got {ratio!r}")
             run.params[rows, RATIO] = np.nan if ratio is None else float(ratio)
+        self._targets_changed()
 
     def stretch_ratios(self) -> np.ndarray:
         """(T, 2) measured width and length ratios of each stretch strip (current / rest)."""
@@ -242,6 +244,7 @@ class Simulation:
             raise SimulationError(f"fold percent must be in [-100, 100], got {percent!r}")
         self._percent = float(percent)
         self._apply_fold_targets()
+        self._targets_changed()
 
     def add_position_target(self, vertices, positions=None, alpha: float = 1.0,
                             decay: float = 1.0, name: str | None = None) -> str:
@@ -261,17 +264,21 @@ class Simulation:
         name = name or f"target{len(self._position_targets)}"
         self._position_targets[name] = PositionTarget(ids, pos, float(alpha), float(decay))
         self._update_pins()
+        self._targets_changed()
         return name
 
     def move_position_target(self, name: str, positions) -> None:
         """New positions (mm) for an existing target (no refactor needed)."""
         target = self._position_targets[name]
-        target.positions = np.broadcast_to(np.asarray(positions, float), target.positions.shape).copy()
+        target.positions = np.broadcast_to(np.asarray(positions, float),
+                                           target.positions.shape).copy()
+        self._targets_changed()
 
     def remove_position_target(self, name: str) -> None:
         """Stop pulling the vertices of a target."""
         del self._position_targets[name]
         self._update_pins()
+        self._targets_changed()
 
     def set_positions(self, positions) -> None:
         """Start the next iteration from these vertex positions, (N, 3) mm.
@@ -448,6 +455,11 @@ class Simulation:
                       list(self._monitor.failures) if self._monitor is not None else [])
 
     # --------------------------------------------------------------- private
+    def _targets_changed(self) -> None:
+        """Targets moved: an accelerated strategy's history (energies, gradients) is stale."""
+        if getattr(self, "_accelerated", None) is not None:
+            self._accelerated.restart(self.x)
+
     def _check_every_vertex_used(self) -> None:
         """A vertex in no element has no equation: K would be singular there."""
         used = np.zeros(self.mesh.n_vertices, dtype=bool)

@@ -220,7 +220,7 @@ def _attach_strip_sides(pattern, e, lines, corners, corner_ids, table, inserts, 
 
 def thicken(pattern: CreasePattern, thickness: float, hinge_width=None,
             subdivisions="auto", bend_radius: float = 0.0, exact_arc: bool = True,
-            stiffness=None, stretch=None) -> ThickMesh:
+            stiffness=None, stretch=None, elastic=None) -> ThickMesh:
     """Build the thick prism mesh of a crease pattern (paper §2.2).
 
     Parameters
@@ -254,6 +254,14 @@ def thicken(pattern: CreasePattern, thickness: float, hinge_width=None,
         one strip each, group ``stretch_hinge``) instead of bending hinges;
         ν in [−1, 0.5]. They start passive (free to stretch); actuate them
         with :meth:`foldcore.Simulation.set_stretch_ratios`.
+    elastic : dict {face id: n}, optional
+        Elastic panels (§5.5): the face becomes n prisms ("cells") side by side
+        along the direction away from its crease, each a panel element whose
+        target is its own rest shape, so the panel bends where its cells meet
+        (its stiffness factor scales every cell). 1D only, as in the paper's
+        bars: the face must be a quadrilateral with exactly one crease side
+        and no hinge ends inside its sides. ``panel_of_face`` then names the
+        cell next to the crease, so fold angles are measured at the hinge.
 
     Returns
     -------
@@ -277,10 +285,12 @@ def thicken(pattern: CreasePattern, thickness: float, hinge_width=None,
         sides = _attach_strip_sides(pattern, e, lines, corners, corner_ids, table, inserts, scale)
         inner = [[table.add(lines[j, 0]), table.add(lines[j, 1])] for j in range(1, ks[e])]
         strip_points[int(e)] = [sides[0]] + inner + [sides[ks[e]]]
+    loops = _panel_loops(corner_ids, inserts)
+    cells = _elastic_cells(pattern, loops, elastic, table)
     points = np.array(table.coords)
     stiff = stiffness or {}
-    panels = _panel_group(pattern, points, corner_ids, inserts, thickness,
-                          stiff.get("panel", 1.0))
+    panels, panel_of_face = _panel_group(pattern, points, loops, cells, thickness,
+                                         stiff.get("panel", 1.0))
     bending = {e: lines for e, lines in strip_points.items() if e not in stretch}
     hinges, strips_of = _hinge_group(pattern, points, bending, widths, ks, thickness,
                                      exact_arc, stiff.get("hinge", 1.0))
@@ -289,7 +299,7 @@ def thicken(pattern: CreasePattern, thickness: float, hinge_width=None,
         groups["stretch_hinge"] = _stretch_group(pattern, points, strip_points, stretch,
                                                  widths, thickness, stiff.get("hinge", 1.0))
     return ThickMesh(points=points, thickness=float(thickness), groups=groups,
-                     panel_of_face=np.arange(len(pattern.faces), dtype=np.int64),
+                     panel_of_face=panel_of_face,
                      strips_of_crease=strips_of, hinge_width=widths, subdivisions=ks)
 
 
@@ -303,22 +313,74 @@ def _prism(ids2d, points, thickness):
     return ids2d, xyz - xyz.mean(axis=0)
 
 
-def _panel_group(pattern, points, corner_ids, inserts, thickness, stiffness):
-    loops, rests, vols = [], [], []
-    n_top = len(points)
+def _panel_loops(corner_ids, inserts) -> list:
+    """Footprint point ids of each panel: its corners with the strip ends inserted."""
+    loops = []
     for f, ids in enumerate(corner_ids):
         loop = []
         for i, cid in enumerate(ids):
             loop.append(cid)
             loop += inserts[f].get(i, [])
-        loop2d, rest = _prism(loop, points, thickness)
-        loops.append(np.concatenate([loop2d, loop2d + n_top]))
-        rests.append(rest)
-        vols.append(_polygon_area(points[loop2d]) * thickness)
-    vols = np.array(vols)
-    return _group("rigid_panel", loops, rests, np.zeros((len(loops), 0)), vols,
-                  vols * np.broadcast_to(stiffness, vols.shape),
-                  np.arange(len(loops), dtype=np.int64))
+        loops.append(loop)
+    return loops
+
+
+def _elastic_cells(pattern, loops, elastic, table) -> dict:
+    """{face: [cell loops]}: each elastic face cut into n quads parallel to its crease side."""
+    cells = {}
+    for f, n in dict(elastic or {}).items():
+        f, loop = int(f), None
+        if not 0 <= f < len(pattern.faces):
+            raise MeshError(f"{pattern.source}: elastic panel: face {f} does not exist")
+        loop = loops[f]
+        if int(n) != n or n < 1:
+            raise MeshError(f"{pattern.source}: elastic panel on face {f}: the number of "
+                            f"cells must be a positive integer, got {n!r}")
+        side = _single_crease_side(pattern, f, len(loop))
+        a, b, c, d = (loop[(side + k) % 4] for k in range(4))
+        pa, pb, pc, pd = (table.coords[i] for i in (a, b, c, d))
+        inner_a = [table.add(pa + t * (pd - pa)) for t in np.arange(1, n) / n]
+        inner_b = [table.add(pb + t * (pc - pb)) for t in np.arange(1, n) / n]
+        side_a, side_b = [a] + inner_a + [d], [b] + inner_b + [c]
+        cells[f] = [[side_a[j], side_b[j], side_b[j + 1], side_a[j + 1]] for j in range(int(n))]
+    return cells
+
+
+def _single_crease_side(pattern, f: int, n_points: int) -> int:
+    """Index of the one crease side of quadrilateral face ``f`` (MeshError otherwise)."""
+    face = pattern.faces[f]
+    creases = [i for i, (u, v) in enumerate(zip(face, np.roll(face, -1)))
+               if pattern.assignments[_edge_of(pattern, u, v)] != "B"]
+    if len(face) != 4 or n_points != 4 or len(creases) != 1:
+        raise MeshError(f"{pattern.source}: elastic panel on face {f}: only quadrilateral "
+                        "faces with exactly one crease side (a bar) can be subdivided, got "
+                        f"{len(face)} sides with {len(creases)} creases")
+    return creases[0]
+
+
+def _edge_of(pattern, u: int, v: int) -> int:
+    ends = pattern.edges
+    return int(np.flatnonzero(((ends[:, 0] == u) & (ends[:, 1] == v))
+                              | ((ends[:, 0] == v) & (ends[:, 1] == u)))[0])
+
+
+def _panel_group(pattern, points, loops, cells, thickness, stiffness):
+    """The panel group (whole panels, or the cells of elastic ones) and each face's
+    measuring element (the panel, or the cell next to the crease)."""
+    prisms, rests, vols, source, panel_of_face = [], [], [], [], []
+    n_top = len(points)
+    for f, loop in enumerate(loops):
+        panel_of_face.append(len(prisms))
+        for cell in cells.get(f, [loop]):
+            loop2d, rest = _prism(cell, points, thickness)
+            prisms.append(np.concatenate([loop2d, loop2d + n_top]))
+            rests.append(rest)
+            vols.append(_polygon_area(points[loop2d]) * thickness)
+            source.append(f)
+    vols, source = np.array(vols), np.array(source, dtype=np.int64)
+    factor = np.broadcast_to(np.asarray(stiffness, dtype=float), (len(loops),))[source]
+    return (_group("rigid_panel", prisms, rests, np.zeros((len(prisms), 0)), vols,
+                   vols * factor, source), np.array(panel_of_face, dtype=np.int64))
 
 
 def _polygon_area(xy) -> float:

@@ -22,6 +22,7 @@ NAMES = {
     "waterbomb": "6-crease waterbomb base, its two stable positions (paper Table 1)",
     "miura": "Miura-ori sheet on its rigid-folding path",
     "hinge-study": "one hinge folded 180°: bend radius and angle error vs subdivisions",
+    "groove-bar": "elastic bar with a 90° V-groove joint pulled past its limit",
 }
 
 
