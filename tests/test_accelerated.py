@@ -100,3 +100,25 @@ def test_cli_accepts_the_strategies_and_reports_the_iteration_cost(tmp_path):
     assert data["per_iteration_s"] == pytest.approx(per_iteration)
     assert data["per_iteration_vs_bare_solve"] == pytest.approx(
         per_iteration / data["timings_s"]["bare_solve"])
+
+
+@pytest.mark.parametrize("solver", ["anderson", "lbfgs"])
+def test_moving_a_position_target_restarts_the_history(solver):
+    """Moving a target changes b(x) but not K: a strategy that kept its history
+    (L-BFGS its cached gradient) stopped at once where the old target was. The
+    pull here is exactly reachable (exact-arc kinematics of a 45° fold), so the
+    hinge must end at 45° to 0.01°."""
+    from foldcore.scenes.groove_bar import PANEL, WIDTH, arc_pose
+
+    pattern = patterns.single_hinge(panel_length=PANEL, depth=10.0, width=WIDTH)
+    mesh = thicken(pattern, 2.0, subdivisions=4)
+    rest = mesh.rest_positions
+    held = np.flatnonzero(np.isclose(rest[:, 0], -PANEL))
+    pulled = np.flatnonzero(np.isclose(rest[:, 0], PANEL))
+    sim = Simulation(mesh, pattern, solver=solver)
+    sim.add_position_target(held)
+    sim.add_position_target(pulled, name="pull")
+    sim.run(tolerance=1e-10, max_iterations=100)
+    sim.move_position_target("pull", arc_pose(rest[pulled], 45.0))
+    result = sim.run(tolerance=1e-10, max_iterations=20_000)
+    assert abs(result.fold_angles_deg[0] - 45.0) < 0.01
