@@ -855,6 +855,11 @@ def test_elastic_panels_are_cells_along_the_bar():
     assert mesh.n_vertices == plain.n_vertices + 2 * 2 * 4   # 4 cut lines, 2 points, 2 layers
     with pytest.raises(MeshError, match="face 1: the number of cells"):
         thicken(pattern, 2.0, elastic={1: 0})
+    # panel 40 − W/2 = 38.5 mm long: cells of at most 5 mm → 8 cells
+    auto = thicken(pattern, 2.0, elastic={1: "auto"}, cell_size=5.0)
+    assert (auto.groups["rigid_panel"].source == 1).sum() == 8
+    with pytest.raises(MeshError, match="'auto' needs a positive cell_size"):
+        thicken(pattern, 2.0, elastic={1: "auto"})
     with pytest.raises(MeshError, match="face 7 does not exist"):
         thicken(pattern, 2.0, elastic={7: 3})
     vertex = patterns.degree4_vertex(radius=20.0, widths=[1.0] * 4)

@@ -220,7 +220,8 @@ def _attach_strip_sides(pattern, e, lines, corners, corner_ids, table, inserts, 
 
 def thicken(pattern: CreasePattern, thickness: float, hinge_width=None,
             subdivisions="auto", bend_radius: float = 0.0, exact_arc: bool = True,
-            stiffness=None, stretch=None, elastic=None) -> ThickMesh:
+            stiffness=None, stretch=None, elastic=None,
+            cell_size: float | None = None) -> ThickMesh:
     """Build the thick prism mesh of a crease pattern (paper §2.2).
 
     Parameters
@@ -254,7 +255,7 @@ def thicken(pattern: CreasePattern, thickness: float, hinge_width=None,
         one strip each, group ``stretch_hinge``) instead of bending hinges;
         ν in [−1, 0.5]. They start passive (free to stretch); actuate them
         with :meth:`foldcore.Simulation.set_stretch_ratios`.
-    elastic : dict {face id: n}, optional
+    elastic : dict {face id: n or "auto"}, optional
         Elastic panels (§5.5): the face becomes n prisms ("cells") side by side
         along the direction away from its crease, each a panel element whose
         target is its own rest shape, so the panel bends where its cells meet
@@ -262,6 +263,9 @@ def thicken(pattern: CreasePattern, thickness: float, hinge_width=None,
         bars: the face must be a quadrilateral with exactly one crease side
         and no hinge ends inside its sides. ``panel_of_face`` then names the
         cell next to the crease, so fold angles are measured at the hinge.
+        ``"auto"``: n = ⌈panel length / ``cell_size``⌉.
+    cell_size : float, optional
+        Target cell length (mm) for ``elastic`` faces given as ``"auto"``.
 
     Returns
     -------
@@ -286,7 +290,7 @@ def thicken(pattern: CreasePattern, thickness: float, hinge_width=None,
         inner = [[table.add(lines[j, 0]), table.add(lines[j, 1])] for j in range(1, ks[e])]
         strip_points[int(e)] = [sides[0]] + inner + [sides[ks[e]]]
     loops = _panel_loops(corner_ids, inserts)
-    cells = _elastic_cells(pattern, loops, elastic, table)
+    cells = _elastic_cells(pattern, loops, elastic, table, cell_size)
     points = np.array(table.coords)
     stiff = stiffness or {}
     panels, panel_of_face = _panel_group(pattern, points, loops, cells, thickness,
@@ -325,20 +329,26 @@ def _panel_loops(corner_ids, inserts) -> list:
     return loops
 
 
-def _elastic_cells(pattern, loops, elastic, table) -> dict:
+def _elastic_cells(pattern, loops, elastic, table, cell_size) -> dict:
     """{face: [cell loops]}: each elastic face cut into n quads parallel to its crease side."""
     cells = {}
     for f, n in dict(elastic or {}).items():
-        f, loop = int(f), None
+        f = int(f)
         if not 0 <= f < len(pattern.faces):
             raise MeshError(f"{pattern.source}: elastic panel: face {f} does not exist")
         loop = loops[f]
-        if int(n) != n or n < 1:
-            raise MeshError(f"{pattern.source}: elastic panel on face {f}: the number of "
-                            f"cells must be a positive integer, got {n!r}")
         side = _single_crease_side(pattern, f, len(loop))
         a, b, c, d = (loop[(side + k) % 4] for k in range(4))
         pa, pb, pc, pd = (table.coords[i] for i in (a, b, c, d))
+        if isinstance(n, str) and n == "auto":
+            if not (cell_size is not None and np.isfinite(cell_size) and cell_size > 0):
+                raise MeshError(f"{pattern.source}: elastic panel on face {f}: 'auto' needs "
+                                f"a positive cell_size in mm, got {cell_size!r}")
+            length = 0.5 * (np.linalg.norm(pd - pa) + np.linalg.norm(pc - pb))
+            n = max(1, int(np.ceil(length / cell_size - 1e-9)))
+        if isinstance(n, str) or int(n) != n or n < 1:
+            raise MeshError(f"{pattern.source}: elastic panel on face {f}: the number of "
+                            f"cells must be a positive integer or 'auto', got {n!r}")
         inner_a = [table.add(pa + t * (pd - pa)) for t in np.arange(1, n) / n]
         inner_b = [table.add(pb + t * (pc - pb)) for t in np.arange(1, n) / n]
         side_a, side_b = [a] + inner_a + [d], [b] + inner_b + [c]
