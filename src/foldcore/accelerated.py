@@ -18,8 +18,9 @@ quadratic E(x) = tr(xᵀKx) − 2 tr(xᵀb) + const, so
   backtracking line search on E; when the search fails it takes the plain
   step and forgets.
 
-A change of K (stops closing, pins decaying) makes the history stale: both
-forget it. The passive hinges' Eq. 9 targets depend on x in a way no energy
+A change of K (stops closing, pins decaying) or of the targets (new fold
+angles, a moved position target: b(x) changes, K does not) makes the history
+stale: both forget it (:meth:`restart`, called by the Simulation). The passive hinges' Eq. 9 targets depend on x in a way no energy
 derives from, so E is only approximately a potential of the map; the
 safeguards are what keep the iteration monotone where it can be.
 Positions are (N, 3) mm; the three coordinates share K, so inner products
