@@ -172,8 +172,10 @@ def render_frames(pattern, mesh, positions, *, size=(640, 480), view="iso", scal
         if len(scalars) != len(positions):
             raise RenderError(f"{len(scalars)} scalar arrays for {len(positions)} frames")
         options.update(scalars=scalars[0], scalar_name=scalar_name,
-                       clim=clim or colour_limits(np.concatenate(scalars)))
+                       clim=colour_limits(np.concatenate(scalars)) if clim is None else clim)
     title = None if titles is None else list(titles)
+    if title is not None and len(title) != len(positions):
+        raise RenderError(f"{len(title)} titles for {len(positions)} frames")
     frames = []
     with Renderer(pattern, mesh, size, view, title=title[0] if title else None,
                   **options) as r:

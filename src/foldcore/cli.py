@@ -234,19 +234,16 @@ def simulate(args) -> int:
 
 def _animate(args, sim):
     """Fold ``sim`` from 0 to --fold-percent in --frames steps, write --animate; last Result."""
-    from .animate import fold_sweep, percent_schedule, render_frames, write_animation
+    from .animate import animate, percent_schedule
 
-    percents = percent_schedule(args.frames, args.fold_percent)
-    results = fold_sweep(sim, percents, tolerance=args.tolerance,
-                         max_iterations=args.max_iterations)
-    frames = render_frames(sim.pattern, sim.mesh, [r.positions for r in results],
-                           titles=[f"fold {p:.4g} %" for p in percents])
-    unconverged = sum(not r.converged for r in results[:-1])
+    movie = animate(sim, percent_schedule(args.frames, args.fold_percent), args.animate,
+                    fps=args.fps, tolerance=args.tolerance,
+                    max_iterations=args.max_iterations)
+    unconverged = sum(not r.converged for r in movie.results[:-1])
     if unconverged:
-        print(f"foldcore: warning: {unconverged} of {len(results) - 1} intermediate animation "
-              "frames not converged", file=sys.stderr)
-    write_animation(args.animate, frames, args.fps)
-    return results[-1]
+        print(f"foldcore: warning: {unconverged} of {len(movie.results) - 1} intermediate "
+              "animation frames not converged", file=sys.stderr)
+    return movie.results[-1]
 
 
 def render_result(args) -> int:
