@@ -42,6 +42,10 @@ LAMBDA_MIN, LAMBDA_MAX = 1e-12, 1e12
 BOUND_TOL = 1e-12    # rad: a bounded angle this close to its bound is on it
 GEODESIC_H = 0.1     # finite-difference step of the geodesic acceleration (fraction of the step)
 GEODESIC_MAX = 1.5   # acceleration kept only if |a| ≤ this × |v|
+MV_STIFFNESS = 1e3   # weight (× reference weight × W²) of the panels' M/V side rows; 0: off
+MV_SLACK = 1e-9      # rad a panel dihedral may cross to the wrong side before its row acts
+#                      (flat panels cross zero by rounding; rows there would make paths
+#                      depend on the last bit, e.g. on the length unit)
 
 
 class State(NamedTuple):
@@ -110,6 +114,7 @@ class RigidBodySolver:
         self.backend = sim.system.factor.backend
         self._init_panels(mesh.groups["rigid_panel"], mesh.n_vertices, sim.x)
         self._init_strips(sim._hinges)
+        self._init_mv_sides(mesh, sim.pattern)
         self.lam = LAMBDA_START
         self._passive = None
         self._fitted = False
@@ -205,6 +210,57 @@ class RigidBodySolver:
         self.carry_panel = np.concatenate(panel) if panel else np.zeros(0, dtype=np.int64)
         self.carry_weight = np.concatenate(weight) if weight else np.zeros(0)
         self.carry_slot = free_index[self.carry_vert]
+
+    def _init_mv_sides(self, mesh, pattern) -> None:
+        """M/V creases whose panels' dihedral is held on the assigned side (one-sided rows).
+
+        The strips' angle bounds alone let the panels cross to the other side
+        (the strips then strain): a thin degree-4 vertex assigned mode B folded
+        mode A's way (measured). A row √μ·min(0, s·ρ + ``MV_SLACK``) per M/V
+        crease, ρ the panels' dihedral, s = +1 valley / −1 mountain, makes that
+        cost; with ``passive_floor_deg`` > 0 (a pre-bend on the assigned side)
+        the vertex then folds its assigned mode.
+        """
+        kinds = pattern.assignments
+        crease = np.flatnonzero(((kinds == "M") | (kinds == "V"))
+                                & (pattern.edge_faces[:, 1] >= 0))
+        if MV_STIFFNESS <= 0:
+            crease = crease[:0]
+        self.mv_left = mesh.panel_of_face[pattern.edge_faces[crease, 0]]
+        self.mv_right = mesh.panel_of_face[pattern.edge_faces[crease, 1]]
+        self.mv_sign = np.where(kinds[crease] == "V", 1.0, -1.0)
+        d2 = pattern.vertices[pattern.edges[crease, 1]] - pattern.vertices[pattern.edges[crease, 0]]
+        self.mv_axis = np.column_stack([d2, np.zeros(len(crease))])
+        self.mv_sqrt = np.sqrt(MV_STIFFNESS * self.sim.system.reference_weight) \
+            * mesh.hinge_width[crease]
+
+    def _mv_terms(self, rot_p):
+        """(residual rows (C,), ∂ρ/∂ω of the left panel (C, 3)) of the M/V side rows."""
+        left, right = rot_p[self.mv_left], rot_p[self.mv_right]
+        d = np.einsum("nij,nj->ni", left + right, self.mv_axis)
+        d /= np.linalg.norm(d, axis=1)[:, None]
+        n_l, n_r = left[:, :, 2], right[:, :, 2]
+        rho = np.arctan2(np.einsum("ni,ni->n", np.cross(n_r, n_l), d),
+                         np.einsum("ni,ni->n", n_l, n_r))
+        side = self.mv_sign * rho + MV_SLACK
+        wrong = side < 0.0
+        return np.where(wrong, self.mv_sqrt * side, 0.0), \
+            np.where(wrong[:, None], (self.mv_sqrt * self.mv_sign)[:, None] * d, 0.0)
+
+    def _mv_rows(self, rot_p, n_columns: int):
+        """(C, n_unknowns) Jacobian of the M/V rows: +∂ on the left panel's rotation
+        columns, − on the right's (∂ρ/∂ω_L = d̂ = −∂ρ/∂ω_R, checked by differences)."""
+        _, grad = self._mv_terms(rot_p)
+        rows, cols, vals = [], [], []
+        for panels, sign in ((self.mv_left, 1.0), (self.mv_right, -1.0)):
+            col = self.panel_col[panels]
+            moving = np.flatnonzero(col >= 0)
+            for k in range(3):
+                rows.append(moving)
+                cols.append(col[moving] + k)
+                vals.append(sign * grad[moving, k])
+        return sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+                             shape=(len(self.mv_sign), n_columns))
 
     def _strip_position_jacobian(self):
         """Constant (24 S, 3 N) Jacobian of the strip residuals w.r.t. positions: √w·C ⊗ I₃."""
@@ -306,12 +362,14 @@ class RigidBodySolver:
 
     def _residuals_at_shapes(self, state: State) -> np.ndarray:
         """:meth:`_residuals` with the strip shapes already those of ``state.phi``."""
-        strips = self._residual(state.x, state.rot_e).ravel()
+        parts = [self._residual(state.x, state.rot_e).ravel()]
         pins = self._pin_terms()
-        if pins is None:
-            return strips
-        v, w, p = pins
-        return np.concatenate([strips, (w[:, None] * (state.x[v] - p)).ravel()])
+        if pins is not None:
+            v, w, p = pins
+            parts.append((w[:, None] * (state.x[v] - p)).ravel())
+        if len(self.mv_sign):
+            parts.append(self._mv_terms(state.rot_p)[0])
+        return np.concatenate(parts) if len(parts) > 1 else parts[0]
 
     def _pin_rows(self):
         """(3 n_pin, 3N) Jacobian rows of the position targets w.r.t. positions, or None."""
@@ -398,8 +456,10 @@ class RigidBodySolver:
         jx = self.jx if pins is None else sp.vstack([self.jx, pins]).tocsr()
         zero = sp.csr_matrix((jx.shape[0] - 24 * s, 3 * s + self.n_folds))
         hinge_cols = sp.vstack([sp.hstack([rot_block, phi_block]), zero])
-        jac = sp.hstack([jx @ p_map, hinge_cols]).tocsc()
-        return jac, residual
+        jac = sp.hstack([jx @ p_map, hinge_cols])
+        if len(self.mv_sign):
+            jac = sp.vstack([jac, self._mv_rows(state.rot_p, jac.shape[1])])
+        return jac.tocsc(), residual
 
     def step(self) -> tuple[float, float]:
         """One Levenberg–Marquardt iteration with geodesic acceleration.
