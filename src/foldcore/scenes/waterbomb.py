@@ -10,9 +10,10 @@ folded from the flat sheet by hinge actuation — position 1: the three
 mountain creases to −82° (the prototype's θm), valleys passive; position 2:
 the three valleys to 55° (the prototype's θv), mountains passive. The paper
 reaches position 2 from position 1 by position actuation (popping the centre
-through); with the current model that push drives the passive mountains to
-+135° (their strips held at 0°, the panels past them: measured), so the
-pop-through is not reproduced yet. The final result (FOLD/PNG) is position 2.
+through); pushing the centre to its mirror image with all creases passive
+keeps the M/V signs (rigid strategy) but ends near θm = −180°, θv = 58°
+(not converged in 400 iterations, measured), not at Table 1's −20°/55°, so
+the pop-through is not reproduced yet. The final result (FOLD/PNG) is position 2.
 
 Quantities: θm, θv (mean over each family) at both positions beside Table 1
 (prototype −82/32 and −20/55; paper's simulation −82/24 and −17/58) and the
