@@ -19,12 +19,13 @@ from __future__ import annotations
 import json
 import sys
 import xml.etree.ElementTree as ET
-from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
 import pytest
 
+import folded
+from folded import scene
 from foldcore import patterns
 from foldcore.cli import main
 from foldcore.fabrication import (ExportError, atomic_path, read_result, sheet_outlines,
@@ -33,33 +34,9 @@ from foldcore.fabrication import (ExportError, atomic_path, read_result, sheet_o
 SVG_NS = "{http://www.w3.org/2000/svg}"
 
 
-@lru_cache(maxsize=None)
-def scene(name: str):
-    """(pattern, mesh, result) folded with the rigid strategy (as tests/test_render.py)."""
-    from foldcore.simulation import Simulation
-    from foldcore.thickening import thicken
-
-    if name == "hinge":
-        pattern = patterns.single_hinge(panel_length=5.0, depth=4.0, angle=90.0, width=2.0)
-        mesh = thicken(pattern, 1.0, subdivisions=4)
-    else:
-        pattern = patterns.degree4_vertex(radius=20.0, widths=(4.0, 1.0, 2.0, 1.0), rho1=90.0)
-        mesh = thicken(pattern, 1.0)
-    result = Simulation(mesh, pattern, solver="rigid").run(tolerance=1e-10,
-                                                           max_iterations=200)
-    assert result.converged
-    return pattern, mesh, result
-
-
 @pytest.fixture
 def result_fold(tmp_path):
-    """The folded d4 scene written as ``simulate -o`` writes it."""
-    from foldcore.outputs import write_result
-
-    pattern, mesh, result = scene("d4")
-    path = tmp_path / "d4.fold"
-    write_result(result, pattern, mesh, 1.0, {}, fold=path)
-    return path
+    return folded.result_fold(tmp_path)
 
 
 def _area(xy) -> float:

@@ -22,12 +22,13 @@ from __future__ import annotations
 import os
 import subprocess
 import sys
-from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
 import pytest
 
+import folded
+from folded import scene
 from foldcore import patterns
 from foldcore.cli import main
 
@@ -43,26 +44,6 @@ DATA = Path(__file__).parent / "data"
 SIZE = (400, 300)
 PIXEL_TOLERANCE = 24      # of 255, largest channel difference still "the same"
 MAX_CHANGED = 0.005       # fraction of pixels allowed to differ by more
-
-
-@lru_cache(maxsize=None)
-def scene(name: str):
-    """(pattern, mesh, result) of a test scene, folded with the rigid strategy."""
-    from foldcore.simulation import Simulation
-    from foldcore.thickening import thicken
-
-    if name == "hinge":
-        pattern = patterns.single_hinge(panel_length=5.0, depth=4.0, angle=90.0, width=2.0)
-        mesh = thicken(pattern, 1.0, subdivisions=4)
-    elif name == "d4":
-        pattern = patterns.degree4_vertex(radius=20.0, widths=(4.0, 1.0, 2.0, 1.0), rho1=90.0)
-        mesh = thicken(pattern, 1.0)
-    else:
-        raise KeyError(name)
-    result = Simulation(mesh, pattern, solver="rigid").run(tolerance=1e-10,
-                                                           max_iterations=200)
-    assert result.converged
-    return pattern, mesh, result
 
 
 def _changed_fraction(a: np.ndarray, b: np.ndarray) -> float:
@@ -232,13 +213,7 @@ def test_import_foldcore_stays_light():
 # ------------------------------------------------------------- foldcore render
 @pytest.fixture
 def result_fold(tmp_path):
-    """A FOLD written the way ``simulate -o`` writes it, of the folded d4 scene."""
-    from foldcore.outputs import write_result
-
-    pattern, mesh, result = scene("d4")
-    path = tmp_path / "d4.fold"
-    write_result(result, pattern, mesh, 1.0, {}, fold=path)
-    return path
+    return folded.result_fold(tmp_path)
 
 
 @pytest.mark.parametrize("extra", [[], ["--view", "top", "--color-by", "angle"],
