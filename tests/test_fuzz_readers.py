@@ -349,6 +349,28 @@ OBJ_TOKENS = st.sampled_from(["0", "1", "-1", "2", "-2", "9", "0.5", "1e999", "n
                               "-99999999999999999999", "#", "\t", "\x00", "\ufffd"])
 
 
+def _mutate_lines(draw, lines: list, new_line, token) -> None:
+    """1–3 random edits of a file's ``lines`` in place: replace or insert a line
+    drawn from ``new_line``, delete or duplicate one, or swap one of its tokens
+    for one drawn from ``token``."""
+    for _ in range(draw(st.integers(1, 3))):
+        k = draw(st.integers(0, len(lines)))
+        how = draw(st.sampled_from(["replace", "insert", "delete", "duplicate", "token"]))
+        if how == "replace" and k < len(lines):
+            lines[k] = draw(new_line)
+        elif how == "insert":
+            lines.insert(k, draw(new_line))
+        elif how == "delete" and k < len(lines):
+            del lines[k]
+        elif how == "duplicate" and k < len(lines):
+            lines.insert(k, lines[k])
+        elif k < len(lines):
+            tokens = lines[k].split()
+            j = draw(st.integers(0, len(tokens)))
+            tokens[j:j + 1] = [draw(token)]
+            lines[k] = " ".join(tokens)
+
+
 @st.composite
 def obj_line(draw, n_vertices: int) -> str:
     kind = draw(st.sampled_from(["v", "f", "vt", "vn", "o", "g", "s", "usemtl", "V", "F", "#",
@@ -363,22 +385,8 @@ def corrupted_objs(draw) -> tuple[str, str]:
     """(OBJ text, hinge text) of a base mesh with a few lines corrupted."""
     i = draw(st.integers(0, len(BASES) - 1))
     lines, hinges = BASE_OBJS[i].splitlines(), BASE_HINGES[i]
-    for _ in range(draw(st.integers(1, 3))):
-        k = draw(st.integers(0, len(lines)))
-        how = draw(st.sampled_from(["replace", "insert", "delete", "duplicate", "token"]))
-        if how == "replace" and k < len(lines):
-            lines[k] = draw(obj_line(BASES[i].n_vertices))
-        elif how == "insert":
-            lines.insert(k, draw(obj_line(BASES[i].n_vertices)))
-        elif how == "delete" and k < len(lines):
-            del lines[k]
-        elif how == "duplicate" and k < len(lines):
-            lines.insert(k, lines[k])
-        elif k < len(lines):
-            tokens = lines[k].split()
-            j = draw(st.integers(0, len(tokens)))
-            tokens[j:j + 1] = [draw(OBJ_TOKENS | st.integers(-9, 9).map(str))]
-            lines[k] = " ".join(tokens)
+    _mutate_lines(draw, lines, obj_line(BASES[i].n_vertices),
+                  OBJ_TOKENS | st.integers(-9, 9).map(str))
     newline = draw(st.sampled_from(["\n", "\r\n", "\r"]))
     return newline.join(lines) + newline, hinges
 
@@ -497,24 +505,9 @@ def corrupted_hinges(draw) -> tuple[int, str]:
     i = draw(st.integers(0, len(BASES) - 1))
     lines = BASE_HINGES[i].splitlines()
     n_edges = BASES[i].n_edges
-    for _ in range(draw(st.integers(1, 3))):
-        k = draw(st.integers(0, len(lines)))
-        line = " ".join(draw(st.lists(HINGE_TOKENS | st.integers(-2, n_edges + 2).map(str)
-                                      | st.floats().map(repr), max_size=6)))
-        how = draw(st.sampled_from(["replace", "insert", "delete", "duplicate", "token"]))
-        if how == "replace" and k < len(lines):
-            lines[k] = line
-        elif how == "insert":
-            lines.insert(k, line)
-        elif how == "delete" and k < len(lines):
-            del lines[k]
-        elif how == "duplicate" and k < len(lines):
-            lines.insert(k, lines[k])
-        elif k < len(lines):
-            tokens = lines[k].split()
-            j = draw(st.integers(0, len(tokens)))
-            tokens[j:j + 1] = [draw(HINGE_TOKENS)]
-            lines[k] = " ".join(tokens)
+    line = st.lists(HINGE_TOKENS | st.integers(-2, n_edges + 2).map(str)
+                    | st.floats().map(repr), max_size=6).map(" ".join)
+    _mutate_lines(draw, lines, line, HINGE_TOKENS)
     return i, "\n".join(lines) + "\n"
 
 
