@@ -18,28 +18,6 @@ from pathlib import Path
 DEMO_SCENES = ("d4v", "waterbomb", "miura", "hinge-study", "groove-bar")
 
 
-def headline(name: str, quantities: dict) -> str:
-    """One short line of a scene's quantities (angles in degrees, lengths mm)."""
-    if name == "d4v":
-        flat = quantities["flat"]
-        return f"crease 1 at the flat target: {flat['fold_angles_deg'][0]}°"
-    if name == "waterbomb":
-        one, two = quantities["position_1"], quantities["position_2"]
-        return (f"θm/θv {one['theta_m_deg']:.1f}/{one['theta_v_deg']:.1f} and "
-                f"{two['theta_m_deg']:.1f}/{two['theta_v_deg']:.1f}")
-    if name == "miura":
-        worst = max(quantities[k]["max_deviation_deg"] for k in ("zigzag", "straight"))
-        return f"largest deviation from the rigid-fold angles {worst}°"
-    if name == "groove-bar":
-        last = quantities["steps"][-1]
-        return (f"pulled to {last['pull_deg']}°: hinge {last['hinge_angle_deg']}°, "
-                f"panel bent {last['panel_bend_deg']}°")
-    if name == "hinge-study":
-        worst = max(r["angle_error_deg"] for r in quantities["runs"])
-        return f"{len(quantities['runs'])} hinges, largest angle error {worst}°"
-    return ""
-
-
 def main(argv=None) -> int:
     from . import scenes
 
@@ -59,7 +37,7 @@ def main(argv=None) -> int:
         scenes.write(run, out)
         wall = time.perf_counter() - start
         print(f"{name:<13}{run.result.iterations:>11}{str(run.result.converged):>11}"
-              f"{wall:>8.2f}  {headline(name, run.quantities)}", flush=True)
+              f"{wall:>8.2f}  {scenes.headline(name, run.quantities)}", flush=True)
     print(f"wrote {len(chosen)} × (FOLD, PNG, JSON) to {out}/")
     return 0
 

@@ -5,7 +5,8 @@ the quantities the paper reports, beside the closed forms where they exist.
 >>> run = scenes.run("d4v", quick=True)          # doctest: +SKIP
 >>> run.quantities["flat"]["fold_angles_deg"]     # doctest: +SKIP
 
-Every scene module defines ``run(quick=False, solver=None) -> SceneRun``;
+Every scene module defines ``run(quick=False, solver=None) -> SceneRun`` and
+``headline(quantities) -> str`` (one line for the demo);
 ``quick`` lowers iteration budgets for tests, never the geometry. Which
 scenes exist is known without importing them (``NAMES``), so the CLI's
 ``--help`` and this package stay light.
@@ -64,10 +65,18 @@ def run(name: str, quick: bool = False, solver: str | None = None) -> SceneRun:
     solver : str, optional
         Strategy (``foldcore.strategies.SOLVERS``); default: the scene's own.
     """
+    return _module(name).run(quick=quick, solver=solver)
+
+
+def headline(name: str, quantities: dict) -> str:
+    """One short line of scene ``name``'s quantities (angles in degrees, lengths mm)."""
+    return _module(name).headline(quantities)
+
+
+def _module(name: str):
     if name not in NAMES:
         raise FoldcoreError(f"unknown scene {name!r} (available: {', '.join(NAMES)})")
-    module = import_module(f"{__name__}.{name.replace('-', '_')}")
-    return module.run(quick=quick, solver=solver)
+    return import_module(f"{__name__}.{name.replace('-', '_')}")
 
 
 def write(scene: SceneRun, out, png: bool = True) -> list:

@@ -56,3 +56,8 @@ def run(quick: bool = False, solver: str | None = None) -> SceneRun:
     settings = {"solver": solver, "tolerance": TOLERANCE, "max_iterations": budget,
                 "thickness_mm": THICKNESS, "subdivisions": SUBDIVISIONS}
     return SceneRun("d4v", sim.pattern, mesh, THICKNESS, result, quantities, settings)
+
+
+def headline(quantities: dict) -> str:
+    """One line for the demo: crease 1 at the flat target."""
+    return f"crease 1 at the flat target: {quantities['flat']['fold_angles_deg'][0]}°"

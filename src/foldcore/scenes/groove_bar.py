@@ -89,6 +89,14 @@ def run(quick: bool = False, solver: str | None = None) -> SceneRun:
     return SceneRun("groove-bar", pattern, mesh, THICKNESS, result, {"steps": rows}, settings)
 
 
+
+def headline(quantities: dict) -> str:
+    """One line for the demo: hinge and panel at the last pull."""
+    last = quantities["steps"][-1]
+    return (f"pulled to {last['pull_deg']}°: hinge {last['hinge_angle_deg']}°, "
+            f"panel bent {last['panel_bend_deg']}°")
+
+
 def panel_energy(sim) -> float:
     """Σ over panel cells of ‖C x − R·rest‖² at the current positions (mm²)."""
     from elements.rigid_panel import batch

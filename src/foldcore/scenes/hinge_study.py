@@ -60,6 +60,13 @@ def run(quick: bool = False, solver: str | None = None) -> SceneRun:
     return SceneRun("hinge-study", pattern, mesh, THICKNESS, result, {"runs": rows}, settings)
 
 
+
+def headline(quantities: dict) -> str:
+    """One line for the demo: how many hinges, the largest angle error."""
+    worst = max(r["angle_error_deg"] for r in quantities["runs"])
+    return f"{len(quantities['runs'])} hinges, largest angle error {worst}°"
+
+
 def _rounded(value, digits: int = 5):
     return None if value is None else round(value, digits)
 

@@ -66,6 +66,13 @@ def run(quick: bool = False, solver: str | None = None) -> SceneRun:
     return SceneRun("miura", pattern, mesh, THICKNESS, result, quantities, settings)
 
 
+
+def headline(quantities: dict) -> str:
+    """One line for the demo: the largest deviation from the rigid-fold angles."""
+    worst = max(quantities[k]["max_deviation_deg"] for k in ("zigzag", "straight"))
+    return f"largest deviation from the rigid-fold angles {worst}°"
+
+
 def _extents(pattern, mesh, positions) -> dict:
     """Distances between corner facets' centroids along the two lattice directions,
     folded, beside the zero-thickness closed form (mm)."""

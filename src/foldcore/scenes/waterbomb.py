@@ -66,3 +66,10 @@ def run(quick: bool = False, solver: str | None = None) -> SceneRun:
                 "thickness_mm": THICKNESS, "hinge_width_mm": WIDTH,
                 "subdivisions": SUBDIVISIONS, "radius_mm": RADIUS}
     return SceneRun("waterbomb", pattern, mesh, THICKNESS, result, quantities, settings)
+
+
+def headline(quantities: dict) -> str:
+    """One line for the demo: θm/θv at both positions."""
+    one, two = quantities["position_1"], quantities["position_2"]
+    return (f"θm/θv {one['theta_m_deg']:.1f}/{one['theta_v_deg']:.1f} and "
+            f"{two['theta_m_deg']:.1f}/{two['theta_v_deg']:.1f}")
