@@ -36,15 +36,10 @@ from numba import njit, prange
 
 from ._registry import ElementType
 from ._rotation import fit_rotated
+from ._strip import distance, strip_widths
 
 HINGE_PARAMS = ("width", "height", "target", "sign", "max_angle", "floor", "exact_arc")
 W, H, TARGET, SIGN, MAX_ANGLE, FLOOR, EXACT = range(len(HINGE_PARAMS))
-
-
-@njit(cache=True)
-def _dist(x, i, j):
-    return math.sqrt((x[i, 0] - x[j, 0]) ** 2 + (x[i, 1] - x[j, 1]) ** 2
-                     + (x[i, 2] - x[j, 2]) ** 2)
 
 
 @njit(cache=True)
@@ -54,10 +49,9 @@ def estimate_angle(x, ids):
     H_p is the perpendicular height √(s² − d²), s the mean end-face length and
     d = (W_b − W_t)/2, so Eq. 8 trapezoids and exact arcs both return their θ.
     """
-    w_top = 0.5 * (_dist(x, ids[0], ids[1]) + _dist(x, ids[3], ids[2]))
-    w_bot = 0.5 * (_dist(x, ids[4], ids[5]) + _dist(x, ids[7], ids[6]))
-    s = 0.25 * (_dist(x, ids[0], ids[4]) + _dist(x, ids[1], ids[5])
-                + _dist(x, ids[2], ids[6]) + _dist(x, ids[3], ids[7]))
+    w_top, w_bot = strip_widths(x, ids)
+    s = 0.25 * (distance(x, ids[0], ids[4]) + distance(x, ids[1], ids[5])
+                + distance(x, ids[2], ids[6]) + distance(x, ids[3], ids[7]))
     d = 0.5 * (w_bot - w_top)
     return 2.0 * math.atan2(d, math.sqrt(max(s * s - d * d, 0.0)))
 

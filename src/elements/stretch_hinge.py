@@ -19,22 +19,17 @@ from numba import njit, prange
 
 from ._registry import ElementType
 from ._rotation import fit_rotated
+from ._strip import strip_widths
 
 STRETCH_PARAMS = ("width", "height", "ratio", "poisson")
 W, H, RATIO, POISSON = range(len(STRETCH_PARAMS))
 
 
 @njit(cache=True)
-def _dist(x, i, j):
-    return math.sqrt((x[i, 0] - x[j, 0]) ** 2 + (x[i, 1] - x[j, 1]) ** 2
-                     + (x[i, 2] - x[j, 2]) ** 2)
-
-
-@njit(cache=True)
 def estimate_ratio(x, ids, width):
     """Current width over rest width of a strip (mean of its four width edges)."""
-    return 0.25 * (_dist(x, ids[0], ids[1]) + _dist(x, ids[3], ids[2])
-                   + _dist(x, ids[4], ids[5]) + _dist(x, ids[7], ids[6])) / width
+    top, bottom = strip_widths(x, ids)
+    return 0.5 * (top + bottom) / width
 
 
 @njit(cache=True)
