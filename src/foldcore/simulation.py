@@ -465,7 +465,7 @@ class Simulation:
     # --------------------------------------------------------------- private
     def _targets_changed(self) -> None:
         """Targets moved: an accelerated strategy's history (energies, gradients) is stale."""
-        if getattr(self, "_accelerated", None) is not None:
+        if self._accelerated is not None:
             self._accelerated.restart(self.x)
 
     def _check_every_vertex_used(self) -> None:

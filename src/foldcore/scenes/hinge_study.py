@@ -25,6 +25,7 @@ from ..patterns import single_hinge
 from ..simulation import Simulation
 from ..thickening import thicken
 from . import SceneRun
+from ._measure import panel_normal
 
 THICKNESS = 0.5  # mm
 WIDTHS = (0.8, 1.0)  # mm
@@ -102,8 +103,6 @@ def inner_radius(mesh, positions: np.ndarray) -> float | None:
 
 def inner_gap(pattern, mesh, positions: np.ndarray) -> float:
     """Distance (mm) between the two panels' inner (top) faces, along the left panel's normal."""
-    from ._measure import panel_normal
-
     panels = mesh.groups[mesh.panel_group]
     tops = []
     for face in pattern.edge_faces[0]:
