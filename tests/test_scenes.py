@@ -116,8 +116,8 @@ def test_scene_outputs_hold_the_quantities(runs, tmp_path):
 
 
 def test_unknown_scene_is_refused_with_the_list():
-    with pytest.raises(FoldcoreError, match="unknown scene 'box'.*d4v"):
-        scenes.run("box")
+    with pytest.raises(FoldcoreError, match="unknown scene 'teapot'.*d4v"):
+        scenes.run("teapot")
 
 
 def test_demo_main_job_writes_each_scene(tmp_path, capsys):
@@ -137,6 +137,6 @@ def test_cli_scene_writes_outputs_and_refuses_bad_input(tmp_path, capsys):
     report = json.loads((tmp_path / "miura.json").read_text())
     assert report["quantities"]["zigzag"]["closed_form_deg"] == pytest.approx(60.0)
     assert main(["scene", "miura", "--out", str(tmp_path / "missing")]) == 2
-    assert main(["scene", "box"]) == 2
+    assert main(["scene", "teapot"]) == 2
     err = capsys.readouterr().err
-    assert "missing: output folder does not exist" in err and "invalid choice: 'box'" in err
+    assert "missing: output folder does not exist" in err and "invalid choice: 'teapot'" in err
