@@ -15,6 +15,12 @@ Tolerances and why:
 * miura: all creases driven to the zero-thickness angles; the hinge axes sit
   O(W) off the crease lines, so the angles may differ at first order in
   W/a: degrees(2/20) = 5.7°, and the corner distances by ≤ (n−1)·W.
+* chain: in the zero-thickness strip the first row's panel centroids are L
+  apart and the first and last rows (m − 1)·S (kinematics.miura_cell); each
+  hinge strip between them adds at most its width W, so the deployed lengths
+  may exceed those by ≤ W across (one zig-zag hinge) and ≤ (m − 1)·W along.
+  A stop holds: once a hinge is at its 180° limit (± 0.5°) further pushes
+  change the lengths by < 1e-3 mm (rounding of the converged stop).
 * hinge-study: an exact-arc target is compatible, so its inner face is the
   Eq. 7 circle to rounding (1e-6 mm); Eq. 8's polygonal inner face
   approaches it as k grows.
@@ -76,6 +82,30 @@ def test_miura_follows_its_rigid_folding_path(runs):
     slack = (4 - 1) * 2.0
     assert abs(extent["corner_panels_x"] - extent["closed_form_x"]) <= slack
     assert abs(extent["corner_panels_y"] - extent["closed_form_y"]) <= slack
+
+
+def test_chain_shortens_along_as_it_is_pushed_across_then_stops(runs):
+    from foldcore.scenes import chain
+
+    run = runs["chain"]
+    q, rows = run.quantities, run.quantities["pushes"]
+    assert respects_assignment(run.pattern, run.result.fold_angles_deg)
+    assert q["deployed"]["converged"] and all(r["converged"] for r in rows)
+    closed = q["rigid_fold_lengths_mm"]
+    assert 0 <= q["before"]["transverse_mm"] - closed["transverse_mm"] <= chain.WIDTH
+    assert 0 <= q["before"]["longitudinal_mm"] - closed["longitudinal_mm"] <= (chain.M - 1) * chain.WIDTH
+    moving = [r for r in rows if r["max_zigzag_deg"] < 180.0 - 0.5]
+    stopped = [r for r in rows if r["max_zigzag_deg"] >= 180.0 - 0.5]
+    assert len(moving) >= 3 and len(stopped) >= 2
+    for a, b in zip(moving, moving[1:] + stopped[:1]):
+        assert b["transverse_mm"] < a["transverse_mm"]
+        assert b["longitudinal_mm"] < a["longitudinal_mm"]
+    for a, b in zip(stopped, stopped[1:]):
+        assert abs(b["transverse_mm"] - a["transverse_mm"]) < 1e-3
+        assert abs(b["longitudinal_mm"] - a["longitudinal_mm"]) < 1e-3
+    shrink_along = q["before"]["longitudinal_mm"] - q["after"]["longitudinal_mm"]
+    shrink_across = q["before"]["transverse_mm"] - q["after"]["transverse_mm"]
+    assert shrink_along > shrink_across > 0
 
 
 def test_hinge_study_radius(runs):

@@ -24,6 +24,7 @@ NAMES = {
     "miura": "Miura-ori sheet on its rigid-folding path",
     "hinge-study": "one hinge folded 180°: bend radius and angle error vs subdivisions",
     "groove-bar": "elastic bar with a 90° V-groove joint pulled past its limit",
+    "chain": "linear chain of spherical mechanisms (Miura strip) pushed across one end",
 }
 
 
