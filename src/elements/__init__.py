@@ -11,7 +11,19 @@ An element type is a small module holding
 Defining the subclass registers it. Third-party packages can also register
 types through the ``foldcore.elements`` entry-point group (loaded lazily, on the
 first lookup of an unknown name). See ``docs/elements.md``.
+
+Importing the package first drops numba cache files compiled from other
+sources than the current ones (:mod:`elements._cache`: numba keys a kernel on
+its own file only, not on the helpers it calls).
 """
-from ._registry import ElementType, available, get, registered
+from pathlib import Path as _Path
+
+import numba as _numba
+
+from ._cache import drop_stale_kernels as _drop_stale_kernels
+
+_drop_stale_kernels(_Path(__file__).parent, _numba.__version__)
+
+from ._registry import ElementType, available, get, registered  # noqa: E402
 
 __all__ = ["ElementType", "available", "get", "registered"]
