@@ -7,9 +7,19 @@ factorisation). Profiles set per test (``@settings``) inherit this default.
 """
 import os
 
+import pytest
 from hypothesis import settings
 
 settings.register_profile("foldcore", derandomize=True)
 settings.register_profile("foldcore-random", derandomize=False)
 settings.load_profile("foldcore-random" if os.environ.get("FOLDCORE_HYPOTHESIS") == "random"
                       else "foldcore")
+
+
+@pytest.fixture(scope="session")
+def runs():
+    """Every built-in scene at reduced budgets (``quick=True``), run once per session
+    (tests/test_scenes.py, tests/test_scene_box.py)."""
+    from foldcore import scenes
+
+    return {name: scenes.run(name, quick=True) for name in scenes.NAMES}

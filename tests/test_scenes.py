@@ -38,11 +38,6 @@ from foldcore.errors import FoldcoreError
 SIGN_SLACK_DEG = 0.1
 
 
-@pytest.fixture(scope="module")
-def runs():
-    return {name: scenes.run(name, quick=True) for name in scenes.NAMES}
-
-
 def respects_assignment(pattern, angles) -> bool:
     kinds = pattern.assignments[: len(angles)]
     return bool(np.all(angles[kinds == "V"] >= -SIGN_SLACK_DEG)

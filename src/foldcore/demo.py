@@ -15,7 +15,7 @@ import sys
 import time
 from pathlib import Path
 
-DEMO_SCENES = ("d4v", "waterbomb", "miura", "hinge-study", "groove-bar")
+DEMO_SCENES = ("d4v", "waterbomb", "miura", "hinge-study", "groove-bar", "chain", "box")
 
 
 def main(argv=None) -> int:

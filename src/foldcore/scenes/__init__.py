@@ -25,6 +25,7 @@ NAMES = {
     "hinge-study": "one hinge folded 180°: bend radius and angle error vs subdivisions",
     "groove-bar": "elastic bar with a 90° V-groove joint pulled past its limit",
     "chain": "linear chain of spherical mechanisms (Miura strip) pushed across one end",
+    "box": "five-crease hexagonal box (reconstructed) folded at H = 1 and 4 mm: volumes",
 }
 
 
