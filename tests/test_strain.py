@@ -46,22 +46,47 @@ def test_actuated_hinge_strain_matches_the_closed_form(exact_arc, angle):
     np.testing.assert_allclose(result.strip_strains[:, 0], -bottom, rtol=rtol)
 
 
+THETA_F = 45.0  # degrees: the first-failure angle the limits below are chosen for
+
+
+def eq8_limit(theta_f: float) -> float:
+    """Eq. 8: |ε| = (kH/W)·tan(θ/2k) on both faces, so a limit ε fails at
+    θ_f = 2k·atan(εW/(kH)); the limit that fails at ``theta_f`` degrees."""
+    return (K * H / W) * np.tan(np.radians(theta_f) / (2 * K))
+
+
 @pytest.mark.parametrize("assignment, side", [("V", "tension"), ("M", "compression")])
 def test_first_failure_angle_matches_eq8(assignment, side):
-    """Eq. 8: |ε| = (kH/W)·tan(θ/2k) on both faces, so a limit ε fails at
-    θ_f = 2k·atan(εW/(kH)); here ε is chosen for θ_f = 45°."""
-    theta_f = 45.0
-    limit = (K * H / W) * np.tan(np.radians(theta_f) / (2 * K))
+    """The paper's iterations follow a quasi-static path and are checked one by one:
+    the first failure is at θ_f to 0.1°."""
+    limit = eq8_limit(THETA_F)
     sign = 1.0 if assignment == "V" else -1.0
     pattern, mesh = hinge(sign * 90.0, exact_arc=False, assignment=assignment)
     limits = StrainLimits(**{side: limit})
-    sim = Simulation(mesh, pattern, strain_limits=limits)
+    sim = Simulation(mesh, pattern, solver="paper", strain_limits=limits)
     result = sim.run(tolerance=0, max_iterations=20_000,
                      callback=lambda s, moved: not s.result(False).failures)
     (failure,) = result.failures
     assert failure["edge"] == 0 and failure["mode"] == side
-    assert abs(abs(failure["fold_angle_deg"]) - theta_f) < 0.1
+    assert abs(abs(failure["fold_angle_deg"]) - THETA_F) < 0.1
     assert abs(failure["strain"]) == pytest.approx(limit, rel=0.01)
+
+
+def test_accelerated_strategy_finds_the_first_failure_by_a_fold_percent_sweep():
+    """lbfgs is checked where each run ends (its iterates are not physical states), so
+    a sweep of the target in 1 % steps of 90° finds θ_f within one step (0.9°) plus
+    the converged hinge's own error (< 0.1°)."""
+    pattern, mesh = hinge(90.0, exact_arc=False, assignment="V")
+    sim = Simulation(mesh, pattern, solver="lbfgs",
+                     strain_limits=StrainLimits(tension=eq8_limit(THETA_F)))
+    for percent in range(0, 101):
+        sim.set_fold_percent(percent)
+        result = sim.run(tolerance=1e-10, max_iterations=2_000)
+        if result.failures:
+            break
+    (failure,) = result.failures
+    assert failure["fold_percent"] == percent
+    assert THETA_F <= failure["fold_angle_deg"] < THETA_F + 0.9 + 0.1
 
 
 def test_no_failure_below_the_limits_and_report_lists_strains():

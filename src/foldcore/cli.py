@@ -20,7 +20,7 @@ import argparse
 import sys
 import warnings
 
-from .strategies import SOLVERS
+from .strategies import DEFAULT_SOLVER, SOLVERS
 
 EXIT_BAD_INPUT = 2
 
@@ -104,12 +104,12 @@ def build_parser() -> argparse.ArgumentParser:
                      help="sub-strips per hinge, or 'auto' (default)")
     sim.add_argument("--fold-percent", type=float, default=100.0,
                      help="scale all target angles, -100…100 (default 100)")
-    sim.add_argument("--solver", default="paper", choices=SOLVERS,
+    sim.add_argument("--solver", default=DEFAULT_SOLVER, choices=SOLVERS,
                      help="iteration strategy: paper (the paper's local/global map), "
                           "anderson (the same map, safeguarded Anderson acceleration), lbfgs "
                           "(L-BFGS on the same energy, K as initial Hessian) or rigid "
                           "(panels as rigid bodies, Levenberg-Marquardt; far fewer iterations "
-                          "on long panels, rigid panels only); default: paper")
+                          "on long panels, rigid panels only); default: " + DEFAULT_SOLVER)
     sim.add_argument("--tolerance", type=_positive, default=1e-8,
                      help="stop when the largest step is below this × pattern size")
     sim.add_argument("--max-iterations", type=int, default=10_000)

@@ -14,7 +14,7 @@ import elements
 from elements.bending_hinge import FLOOR, TARGET, limit_excess
 from .errors import SimulationError
 from .measure import fold_angles
-from .strategies import SOLVERS
+from .strategies import DEFAULT_SOLVER, SOLVERS
 from .system import System
 
 ALPHA_UPDATE_EVERY = 10  # iterations between α-schedule updates (each costs a refactor)
@@ -101,8 +101,9 @@ class Simulation:
     mesh : ThickMesh
     pattern : CreasePattern
         The pattern the mesh was made from (targets, assignments, measurement).
-    solver : {"paper", "anderson", "lbfgs", "rigid"}
-        Iteration strategy. ``"paper"``: the paper's plain local/global map
+    solver : {"lbfgs", "paper", "anderson", "rigid"}
+        Iteration strategy, default ``"lbfgs"`` (why:
+        :data:`foldcore.strategies.DEFAULT_SOLVER`). ``"paper"``: the paper's plain local/global map
         (every element a soft spring; iterations grow with panel length /
         thickness). ``"anderson"``/``"lbfgs"``: the same local step and K,
         accelerated (safeguarded Anderson; L-BFGS with K as initial Hessian,
@@ -129,9 +130,15 @@ class Simulation:
         Each change of the set of stops costs one numeric refactor.
     strain_limits : StrainLimits, optional
         Material limits of the hinges (:class:`foldcore.strain.StrainLimits`);
-        each iteration then checks every sub-strip's surface strain and the
-        result lists the creases that failed, with the iteration and fold
-        percent of their first failure.
+        every sub-strip's surface strain is then checked and the result lists
+        the creases that failed, with the iteration and fold percent of their
+        first failure. With ``solver="paper"`` every iteration is checked (its
+        iterations follow a quasi-static path, as in the paper's §6.4); the
+        other strategies take long steps whose intermediate iterates are not
+        physical states (measured: an ``lbfgs`` run of a hinge to 90° bent its
+        strips past a 45° limit while its panels read 19°), so they are
+        checked where each run ends: sweep ``set_fold_percent`` to locate a
+        first failure along a path.
     threads : int, optional
         numba threads for the kernels of this simulation (set at each step,
         so simulations in one process do not override each other). Default:
@@ -141,7 +148,7 @@ class Simulation:
         else numba's setting.
     """
 
-    def __init__(self, mesh, pattern, solver: str = "paper", backend: str = "auto",
+    def __init__(self, mesh, pattern, solver: str = DEFAULT_SOLVER, backend: str = "auto",
                  passive_floor_deg: float = 0.0, stop_stiffness: float = 1e3,
                  threads: int | None = None, strain_limits=None):
         start = time.perf_counter()
@@ -316,7 +323,7 @@ class Simulation:
             energy, moved = self._paper_iteration()
         self.energy_history.append(energy)
         self.iterations += 1
-        if self._monitor is not None:
+        if self._monitor is not None and self.solver == "paper":
             self._monitor.check(self.x, self.iterations, self._percent)
         self._advance_alpha()
         return moved
@@ -401,6 +408,8 @@ class Simulation:
                 break
         self.timings["total"] += time.perf_counter() - start
         self.timings["bare_solve"] = self._bare_solve_floor()
+        if self._monitor is not None and self.solver != "paper":
+            self._monitor.check(self.x, self.iterations, self._percent)
         return self.result(converged)
 
     def _bare_solve_floor(self) -> float:
