@@ -865,3 +865,93 @@ def test_elastic_panels_are_cells_along_the_bar():
     vertex = patterns.degree4_vertex(radius=20.0, widths=[1.0] * 4)
     with pytest.raises(MeshError, match="only quadrilateral faces with exactly one crease"):
         thicken(vertex, 1.0, elastic={0: 3})
+
+
+# ============================================================ 2D elastic plates
+def hanging_points(mesh) -> list:
+    """Points lying inside another prism's footprint edge (a T-junction: the mesh would
+    not conform there). Tolerance 1e-9 of the sheet size."""
+    pts = mesh.points
+    scale = float(np.ptp(pts, axis=0).max())
+    bad = []
+    for p in prisms_of(mesh):
+        for a, b in zip(p.top, np.roll(p.top, -1)):
+            d = pts[b] - pts[a]
+            t = (pts - pts[a]) @ d / (d @ d)
+            off = np.linalg.norm(pts - pts[a] - np.outer(t, d), axis=1)
+            inside = (t > 1e-9) & (t < 1 - 1e-9) & (off < 1e-9 * scale)
+            bad += [(p.kind, p.index, int(r)) for r in np.flatnonzero(inside)]
+    return bad
+
+
+def test_plate_cells_tile_the_panel_and_conform_with_the_split_hinge():
+    """A plate face split n1 × n2: n1·n2 cells tiling the panel (same volume as the
+    undivided mesh), every cell and strip sharing whole edges (no T-junctions), the
+    crease's strip split into n2 segments along it, each segment k strips across."""
+    pattern = patterns.single_hinge(panel_length=40.0, depth=20.0, width=3.0)
+    plain = thicken(pattern, 2.0, subdivisions=2)
+    mesh = thicken(pattern, 2.0, subdivisions=2, elastic={1: (4, 3)})
+    panels, hinges = mesh.groups["rigid_panel"], mesh.groups["bending_hinge"]
+    assert list(panels.source) == [0] + [1] * 12
+    assert mesh.segments[0] == 3 and len(mesh.strips_of_crease[0]) == 2 * 3
+    assert panels.volumes.sum() == pytest.approx(plain.groups["rigid_panel"].volumes.sum())
+    assert hinges.volumes.sum() == pytest.approx(plain.groups["bending_hinge"].volumes.sum())
+    assert not hanging_points(mesh)
+    assert all(shoelace(mesh.points[p.top]) > 0 for p in prisms_of(mesh))
+    union = shapely.union_all([p.poly for p in prisms_of(mesh)])
+    assert union.area == pytest.approx(sum(p.poly.area for p in prisms_of(mesh)))
+    # the measuring cell touches the crease side, at its middle (y from D/3 to 2D/3)
+    first = mesh.points[panels.indices[panels.slots(int(mesh.panel_of_face[1]))][:4]]
+    assert first[:, 0].min() == pytest.approx(1.5)
+    assert sorted(np.unique(np.round(first[:, 1], 9))) == pytest.approx([20 / 3, 40 / 3])
+    # the strip outline is still one rectangle W × crease length
+    from foldcore.fabrication import sheet_outlines
+
+    (strip,) = sheet_outlines(mesh)["HINGE"]
+    assert shapely.Polygon(strip).area == pytest.approx(3.0 * 20.0)
+
+
+def test_plates_on_both_sides_share_the_strip_segments_or_are_refused():
+    """(n1, n2) count cells along a face's sides 0/2 and 1/3 in pattern order: face 0
+    is [0, 1, 4, 5] (crease 0→1 is its side 0), face 1 is [0, 2, 3, 1] (side 3)."""
+    pattern = patterns.single_hinge(panel_length=40.0, depth=20.0, width=3.0)
+    mesh = thicken(pattern, 1.0, subdivisions=3, elastic={0: (4, 2), 1: (5, 4)})
+    assert mesh.segments[0] == 4 and not hanging_points(mesh)
+    assert len(mesh.groups["rigid_panel"]) == 4 * 2 + 5 * 4
+    with pytest.raises(MeshError, match="faces 0 and 1 put 4 and 3 cells along their shared "
+                                        "edge 0"):
+        thicken(pattern, 1.0, elastic={0: (4, 2), 1: (5, 3)})
+    with pytest.raises(MeshError, match="face 1: cell counts must be positive"):
+        thicken(pattern, 1.0, elastic={1: (0, 3)})
+    with pytest.raises(MeshError, match="face 1: give two cell counts"):
+        thicken(pattern, 1.0, elastic={1: (2, 3, 4)})
+    auto = thicken(pattern, 1.0, hinge_width=3.0, elastic={1: ("auto", "auto")}, cell_size=5.0)
+    # inset panel 38.5 × 20 mm, cells of at most 5 mm: 8 × 4
+    assert (auto.groups["rigid_panel"].source == 1).sum() == 8 * 4
+    vertex = patterns.degree4_vertex(radius=20.0, widths=[1.0] * 4)
+    with pytest.raises(MeshError, match="only quadrilateral faces can be gridded"):
+        thicken(vertex, 1.0, elastic={1: (2, 2)})
+    with pytest.raises(MeshError, match="stretch hinge"):
+        thicken(pattern, 1.0, elastic={1: (2, 2)}, stretch={0: 0.3})
+
+
+def test_plate_folded_by_a_compatible_hinge_stays_flat():
+    """Hinge actuated to 90°, nothing else: the target is compatible, so the split
+    strips fold as one and the plate's cells stay at their rest shapes (to the
+    solver's tolerance, 1e-6 of the panel length) while the fold reaches 90°."""
+    from foldcore.simulation import Simulation
+
+    pattern = patterns.single_hinge(panel_length=20.0, depth=20.0, width=3.0, angle=90.0)
+    mesh = thicken(pattern, 1.0, subdivisions=2, elastic={1: (4, 4)})
+    result = Simulation(mesh, pattern).run(tolerance=1e-12, max_iterations=5_000)
+    assert result.converged
+    assert result.fold_angles_deg[0] == pytest.approx(90.0, abs=1e-4)
+    cells = mesh.groups["rigid_panel"]
+    x = result.positions
+    for i in range(len(cells)):
+        ids = cells.indices[cells.slots(i)]
+        d_now = np.linalg.norm(x[ids][:, None] - x[ids][None], axis=2)
+        d_rest = np.linalg.norm(cells.rest[cells.slots(i)][:, None]
+                                - cells.rest[cells.slots(i)][None], axis=2)
+        assert np.abs(d_now - d_rest).max() <= 1e-6 * 20.0
+    assert mesh.crease_bends(result.strip_angles_deg)[0] == pytest.approx(90.0, abs=1e-3)

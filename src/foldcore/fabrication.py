@@ -245,12 +245,13 @@ def _top(group, i) -> np.ndarray:
 
 
 def _strip_outline(mesh, e) -> np.ndarray:
-    """Footprint ids of the whole strip of crease ``e``: first and last line ends."""
+    """Footprint ids of the whole strip of crease ``e``: its four corners (the outer
+    sub-strips of its first and last segments along the crease)."""
     hinges = mesh.groups["bending_hinge"]
-    strips = mesh.strips_of_crease[e]
-    first, last = _top(hinges, strips[0]), _top(hinges, strips[-1])
-    # sub-strip top: a_j, a_j+1, b_j+1, b_j
-    return np.array([first[0], last[1], last[2], first[3]])
+    strips, k = mesh.strips_of_crease[e], int(mesh.subdivisions[e])
+    # sub-strip top: a_j, a_j+1, b_j+1, b_j; segment-major, k strips per segment
+    corners = [(strips[0], 0), (strips[k - 1], 1), (strips[-1], 2), (strips[-k], 3)]
+    return np.array([_top(hinges, s)[i] for s, i in corners])
 
 
 def _drop_collinear(xy, scale: float) -> np.ndarray:

@@ -71,7 +71,12 @@ class ThickMesh:
     hinge_width : (E,) float64
         Hinge width used per edge, mm (NaN for boundary edges).
     subdivisions : (E,) int64
-        Sub-strips per edge (0 for boundary edges).
+        Sub-strips per edge across its width (0 for boundary edges).
+    segments : (E,) int64
+        Prisms along each crease (1; more where an elastic plate's cells line
+        the crease, so the strip conforms with them; 0 for boundary edges).
+        ``strips_of_crease[e]`` lists segment after segment, each left to
+        right: k·m strips, k in series across the crease, m side by side.
     panel_group : str
         Name of the group holding the panels.
     """
@@ -83,7 +88,21 @@ class ThickMesh:
     strips_of_crease: dict
     hinge_width: np.ndarray
     subdivisions: np.ndarray
+    segments: np.ndarray | None = None
     panel_group: str = "rigid_panel"
+
+    def __post_init__(self):
+        if self.segments is None:
+            self.segments = (np.asarray(self.subdivisions) > 0).astype(np.int64)
+
+    def crease_bends(self, strip_angles: np.ndarray) -> np.ndarray:
+        """(E,) bend of each crease's hinge from per-strip bend angles (S,): the sum over
+        its k sub-strips in series, averaged over its segments along the crease
+        (units of ``strip_angles``; NaN for boundary edges)."""
+        out = np.full(len(self.subdivisions), np.nan)
+        for e, strips in self.strips_of_crease.items():
+            out[e] = np.asarray(strip_angles)[strips].sum() / self.segments[e]
+        return out
 
     @property
     def n_vertices(self) -> int:

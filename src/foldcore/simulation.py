@@ -496,7 +496,8 @@ class Simulation:
             raise SimulationError(f"strain_limits must be a foldcore.strain.StrainLimits, "
                                   f"got {type(limits).__name__}")
         try:
-            return FailureMonitor(self._hinges.group, limits, self.pattern.n_edges)
+            return FailureMonitor(self._hinges.group, limits, self.pattern.n_edges,
+                                  self.mesh.segments)
         except ValueError as exc:
             raise SimulationError(str(exc)) from None
 

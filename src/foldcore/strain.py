@@ -81,10 +81,14 @@ class FailureMonitor:
     hinge_group : ElementGroup of ``bending_hinge``
     limits : StrainLimits
     n_edges : int
+    segments : (E,) int, optional
+        Strip segments along each crease (``ThickMesh.segments``; default 1):
+        a failure's fold angle is its crease's series sum averaged over them.
     """
 
-    def __init__(self, hinge_group, limits: StrainLimits, n_edges: int):
+    def __init__(self, hinge_group, limits: StrainLimits, n_edges: int, segments=None):
         self.group = hinge_group
+        self.segments = np.ones(n_edges) if segments is None else np.asarray(segments, float)
         tension, compression = limits.per_edge(n_edges)
         self.tension = tension[hinge_group.source]
         self.compression = compression[hinge_group.source]
@@ -107,4 +111,4 @@ class FailureMonitor:
                 "edge": edge, "iteration": int(iteration), "fold_percent": float(fold_percent),
                 "mode": "tension" if over_t[s] else "compression",
                 "strain": float(strain[s].max() if over_t[s] else strain[s].min()),
-                "fold_angle_deg": float(np.degrees(phi[mine].sum()))})
+                "fold_angle_deg": float(np.degrees(phi[mine].sum() / self.segments[edge]))})

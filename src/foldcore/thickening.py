@@ -175,8 +175,9 @@ def _strip_cuts(pattern, e, corners) -> tuple[float, float]:
     return cuts[0], cuts[1]
 
 
-def _strip_lines(pattern, e, width, k, cuts):
-    """(k+1, 2, 2) array: for each line across the strip, its point at end a and b.
+def _strip_lines(pattern, e, width, k, cuts, segments: int = 1):
+    """(k+1, m+1, 2) array: for each line across the strip, its m+1 points from end a
+    to end b (m = ``segments``, equal lengths; 1: just the two ends).
 
     Line 0 is the left side (left face), line k the right side.
     """
@@ -188,7 +189,8 @@ def _strip_lines(pattern, e, width, k, cuts):
                         "hinge widths around it; use narrower hinges")
     u = (pb - pa) / length
     n = _left_normal(u)
-    ends = np.array([pa + cuts[0] * u, pb - cuts[1] * u])
+    along = np.linspace(cuts[0], length - cuts[1], segments + 1)
+    ends = pa + along[:, None] * u
     t = 0.5 * width * (1 - 2 * np.arange(k + 1) / k)
     return ends[None, :, :] + t[:, None, None] * n[None, None, :]
 
@@ -199,17 +201,23 @@ def _close(p, q, scale) -> bool:
 
 
 def _attach_strip_sides(pattern, e, lines, corners, corner_ids, table, inserts, scale):
-    """Ids of the strip's side points, shared with (or inserted into) its panels."""
+    """Ids of the strip's side points (a → b), shared with (or inserted into) its panels.
+
+    A side's end points are the panel's corners where they coincide, else new
+    points inserted into the panel's loop; its intermediate points (a strip
+    split into segments along the crease) are always inserted, in loop order.
+    """
     a, b = pattern.edges[e]
     f_left, f_right = pattern.edge_faces[e]
     side_ids = {}
-    for side, face, (first, second) in ((0, f_left, (a, b)), (len(lines) - 1, f_right, (b, a))):
+    for side, face, first in ((0, f_left, a), (len(lines) - 1, f_right, b)):
         i = _corner_index(pattern, face, first)
         j = (i + 1) % len(pattern.faces[face])
-        pts = lines[side] if side == 0 else lines[side][::-1]
+        pts = lines[side] if side == 0 else lines[side][::-1]  # in the face's loop order
         got = []
-        for point, corner in zip(pts, (i, j)):
-            if _close(point, corners[face][corner], scale):
+        for n, point in enumerate(pts):
+            corner = i if n == 0 else (j if n == len(pts) - 1 else None)
+            if corner is not None and _close(point, corners[face][corner], scale):
                 got.append(corner_ids[face][corner])
             else:
                 got.append(table.add(point))
@@ -255,17 +263,24 @@ def thicken(pattern: CreasePattern, thickness: float, hinge_width=None,
         one strip each, group ``stretch_hinge``) instead of bending hinges;
         ν in [−1, 0.5]. They start passive (free to stretch); actuate them
         with :meth:`foldcore.Simulation.set_stretch_ratios`.
-    elastic : dict {face id: n or "auto"}, optional
-        Elastic panels (§5.5): the face becomes n prisms ("cells") side by side
-        along the direction away from its crease, each a panel element whose
-        target is its own rest shape, so the panel bends where its cells meet
-        (its stiffness factor scales every cell). 1D only, as in the paper's
-        bars: the face must be a quadrilateral with exactly one crease side
-        and no hinge ends inside its sides. ``panel_of_face`` then names the
-        cell next to the crease, so fold angles are measured at the hinge.
-        ``"auto"``: n = ⌈panel length / ``cell_size``⌉.
+    elastic : dict {face id: n, "auto" or (n1, n2)}, optional
+        Elastic panels (§5.5): the face becomes prisms ("cells"), each a panel
+        element whose target is its own rest shape, so the panel deforms
+        where its cells meet (its stiffness factor scales every cell).
+        ``n`` (a bar, as in the paper): n cells side by side away from its one
+        crease side; the face must be a quadrilateral with exactly one crease
+        side and no hinge ends inside its sides; ``panel_of_face`` names the
+        cell next to the crease. ``(n1, n2)`` (a plate, beyond the paper): an
+        n1 × n2 grid of quads, n1 along the face's sides 0 and 2 and n2 along
+        sides 1 and 3 (side i runs from ``pattern.faces[f][i]`` to the next
+        vertex); any number of its sides may be creases, whose strips are then
+        split into as many segments along the crease (``ThickMesh.segments``)
+        so strips and cells share their points (two plates on one crease must
+        agree on the count); the hinge strips must span the plate's sides.
+        ``panel_of_face`` names the cell at the middle of its first crease
+        side. ``"auto"`` (for n or either of n1, n2): ⌈side length / ``cell_size``⌉.
     cell_size : float, optional
-        Target cell length (mm) for ``elastic`` faces given as ``"auto"``.
+        Target cell length (mm) for ``"auto"`` counts.
 
     Returns
     -------
@@ -281,16 +296,21 @@ def thicken(pattern: CreasePattern, thickness: float, hinge_width=None,
     ks[list(stretch)] = 1
     table = _PointTable()
     corners, corner_ids = _corner_ids(pattern, widths, table)
+    bars, plates = _split_elastic(pattern, elastic)
+    plates = _plate_counts(pattern, plates, corners, cell_size)
+    segments = _segments(pattern, plates, stretch)
     inserts: list[dict] = [dict() for _ in pattern.faces]
     scale = float(np.ptp(pattern.vertices, axis=0).max())
     strip_points = {}
     for e in pattern.creases:
-        lines = _strip_lines(pattern, e, widths[e], ks[e], _strip_cuts(pattern, e, corners))
+        lines = _strip_lines(pattern, e, widths[e], ks[e], _strip_cuts(pattern, e, corners),
+                             int(segments[e]))
         sides = _attach_strip_sides(pattern, e, lines, corners, corner_ids, table, inserts, scale)
-        inner = [[table.add(lines[j, 0]), table.add(lines[j, 1])] for j in range(1, ks[e])]
+        inner = [[table.add(p) for p in lines[j]] for j in range(1, ks[e])]
         strip_points[int(e)] = [sides[0]] + inner + [sides[ks[e]]]
     loops = _panel_loops(corner_ids, inserts)
-    cells = _elastic_cells(pattern, loops, elastic, table, cell_size)
+    cells = _elastic_cells(pattern, loops, bars, table, cell_size)
+    cells.update(_plate_cells(pattern, loops, corner_ids, plates, table))
     points = np.array(table.coords)
     stiff = stiffness or {}
     panels, panel_of_face = _panel_group(pattern, points, loops, cells, thickness,
@@ -304,7 +324,8 @@ def thicken(pattern: CreasePattern, thickness: float, hinge_width=None,
                                                  widths, thickness, stiff.get("hinge", 1.0))
     return ThickMesh(points=points, thickness=float(thickness), groups=groups,
                      panel_of_face=panel_of_face,
-                     strips_of_crease=strips_of, hinge_width=widths, subdivisions=ks)
+                     strips_of_crease=strips_of, hinge_width=widths, subdivisions=ks,
+                     segments=segments)
 
 
 def _prism(ids2d, points, thickness):
@@ -332,10 +353,7 @@ def _panel_loops(corner_ids, inserts) -> list:
 def _elastic_cells(pattern, loops, elastic, table, cell_size) -> dict:
     """{face: [cell loops]}: each elastic face cut into n quads parallel to its crease side."""
     cells = {}
-    for f, n in dict(elastic or {}).items():
-        f = int(f)
-        if not 0 <= f < len(pattern.faces):
-            raise MeshError(f"{pattern.source}: elastic panel: face {f} does not exist")
+    for f, n in elastic.items():
         loop = loops[f]
         side = _single_crease_side(pattern, f, len(loop))
         a, b, c, d = (loop[(side + k) % 4] for k in range(4))
@@ -354,6 +372,126 @@ def _elastic_cells(pattern, loops, elastic, table, cell_size) -> dict:
         side_a, side_b = [a] + inner_a + [d], [b] + inner_b + [c]
         cells[f] = [[side_a[j], side_b[j], side_b[j + 1], side_a[j + 1]] for j in range(int(n))]
     return cells
+
+
+def _split_elastic(pattern, elastic) -> tuple[dict, dict]:
+    """Elastic faces as ({face: n or "auto"} bars, {face: (n1, n2)} plates)."""
+    bars, plates = {}, {}
+    for f, n in dict(elastic or {}).items():
+        f = int(f)
+        if not 0 <= f < len(pattern.faces):
+            raise MeshError(f"{pattern.source}: elastic panel: face {f} does not exist")
+        if isinstance(n, (tuple, list)):
+            if len(n) != 2:
+                raise MeshError(f"{pattern.source}: elastic plate on face {f}: give two cell "
+                                f"counts (n1, n2), got {n!r}")
+            plates[f] = tuple(n)
+        else:
+            bars[f] = n
+    return bars, plates
+
+
+def _plate_counts(pattern, plates, corners, cell_size) -> dict:
+    """{face: (n1, n2)} validated, "auto" entries from ``cell_size`` (mm): n1 cells
+    along the face's sides 0 and 2 (its first and third, in pattern order), n2
+    along sides 1 and 3."""
+    out = {}
+    for f, counts in plates.items():
+        if len(pattern.faces[f]) != 4:
+            raise MeshError(f"{pattern.source}: elastic plate on face {f}: only "
+                            f"quadrilateral faces can be gridded, got {len(pattern.faces[f])} "
+                            "sides")
+        c = np.asarray(corners[f])
+        side = np.linalg.norm(np.roll(c, -1, axis=0) - c, axis=1)
+        resolved = []
+        for n, length in zip(counts, (0.5 * (side[0] + side[2]), 0.5 * (side[1] + side[3]))):
+            if isinstance(n, str) and n == "auto":
+                if not (cell_size is not None and np.isfinite(cell_size) and cell_size > 0):
+                    raise MeshError(f"{pattern.source}: elastic plate on face {f}: 'auto' "
+                                    f"needs a positive cell_size in mm, got {cell_size!r}")
+                n = max(1, int(np.ceil(length / cell_size - 1e-9)))
+            if isinstance(n, str) or int(n) != n or n < 1:
+                raise MeshError(f"{pattern.source}: elastic plate on face {f}: cell counts "
+                                f"must be positive integers or 'auto', got {counts!r}")
+            resolved.append(int(n))
+        out[f] = tuple(resolved)
+    return out
+
+
+def _segments(pattern, plates, stretch) -> np.ndarray:
+    """(E,) int: prisms along each crease's strip (1; a plate's cell count along its
+    crease sides, so the strip conforms with the cells; 0 for boundary edges)."""
+    segments = np.where(pattern.assignments == "B", 0, 1).astype(np.int64)
+    owner = {}
+    for f, counts in plates.items():
+        face = pattern.faces[f]
+        for side in range(4):
+            e = _edge_of(pattern, face[side], face[(side + 1) % 4])
+            if pattern.assignments[e] == "B":
+                continue
+            if e in stretch:
+                raise MeshError(f"{pattern.source}: elastic plate on face {f}: its side edge "
+                                f"{e} is a stretch hinge (one strip, cannot follow the cells)")
+            n = counts[side % 2]
+            if e in owner and segments[e] != n:
+                raise MeshError(f"{pattern.source}: elastic plates on faces {owner[e]} and {f} "
+                                f"put {segments[e]} and {n} cells along their shared edge {e}")
+            segments[e], owner[e] = n, f
+    return segments
+
+
+def _plate_cells(pattern, loops, corner_ids, plates, table) -> dict:
+    """{face: [cell loops]}: each plate an n1 × n2 grid of quads (bilinear in its inset
+    corners), its crease sides sharing the split strips' points; the cell at
+    the middle of its first crease side comes first (it measures the face)."""
+    cells = {}
+    for f, (n1, n2) in plates.items():
+        sides = _plate_sides(pattern, f, loops[f], corner_ids[f], (n1, n2, n1, n2), table)
+        c = np.array([table.coords[i] for i in corner_ids[f]])
+        grid = np.empty((n1 + 1, n2 + 1), dtype=np.int64)
+        grid[:, 0], grid[n1, :] = sides[0], sides[1]
+        grid[:, n2], grid[0, :] = sides[2][::-1], sides[3][::-1]
+        for i in range(1, n1):
+            for j in range(1, n2):
+                u, v = i / n1, j / n2
+                grid[i, j] = table.add((1 - u) * (1 - v) * c[0] + u * (1 - v) * c[1]
+                                       + u * v * c[2] + (1 - u) * v * c[3])
+        quads = {(i, j): [grid[i, j], grid[i + 1, j], grid[i + 1, j + 1], grid[i, j + 1]]
+                 for i in range(n1) for j in range(n2)}
+        first = _measuring_cell(pattern, f, n1, n2)
+        cells[f] = [quads[first]] + [q for key, q in quads.items() if key != first]
+    return cells
+
+
+def _plate_sides(pattern, f, loop, corners, counts, table) -> list:
+    """Point ids along each side of a plate's loop, corner to corner (n + 1 each);
+    boundary sides get evenly spaced new points."""
+    at = [loop.index(c) for c in corners]
+    sides = []
+    for s in range(4):
+        stop = at[(s + 1) % 4] if s < 3 else len(loop)
+        ids = loop[at[s]:stop] + [corners[(s + 1) % 4]]
+        if len(ids) == 2 and counts[s] > 1:
+            p, q = table.coords[ids[0]], table.coords[ids[1]]
+            ids = [ids[0]] + [table.add(p + t * (q - p)) for t in
+                              np.arange(1, counts[s]) / counts[s]] + [ids[1]]
+        if len(ids) != counts[s] + 1:
+            raise MeshError(f"{pattern.source}: elastic plate on face {f}: side {s} has "
+                            f"{len(ids) - 2} strip ends inside it, {counts[s] - 1} expected; "
+                            "its hinge strips must span the panel's sides (equal hinge widths "
+                            "around its corners)")
+        sides.append(ids)
+    return sides
+
+
+def _measuring_cell(pattern, f: int, n1: int, n2: int) -> tuple[int, int]:
+    """Grid index (i, j) of the cell at the middle of the face's first crease side."""
+    face = pattern.faces[f]
+    middle = {0: (n1 // 2, 0), 1: (n1 - 1, n2 // 2), 2: (n1 // 2, n2 - 1), 3: (0, n2 // 2)}
+    for side in range(4):
+        if pattern.assignments[_edge_of(pattern, face[side], face[(side + 1) % 4])] != "B":
+            return middle[side]
+    return (0, 0)
 
 
 def _single_crease_side(pattern, f: int, n_points: int) -> int:
@@ -408,18 +546,20 @@ def _hinge_group(pattern, points, strip_points, widths, ks, thickness, exact_arc
         target = pattern.fold_angles[e]
         if pattern.assignments[e] == "F":
             target = 0.0
-        strips_of[e] = np.arange(len(loops), len(loops) + k, dtype=np.int64)
-        length = float(np.linalg.norm(points[lines[0][1]] - points[lines[0][0]]))
-        for j in range(k):
-            quad = [lines[j][0], lines[j + 1][0], lines[j + 1][1], lines[j][1]]
-            loop2d, rest = _prism(quad, points, thickness)
-            loops.append(np.concatenate([loop2d, loop2d + n_top]))
-            rests.append(rest @ frame)
-            params.append(_hinge_params(widths[e] / k, thickness, target, k,
-                                        sign[pattern.assignments[e]],
-                                        pattern.max_angles[e], exact_arc))
-            vols.append(widths[e] / k * length * thickness)
-            source.append(e)
+        m = len(lines[0]) - 1  # segments along the crease
+        strips_of[e] = np.arange(len(loops), len(loops) + k * m, dtype=np.int64)
+        for t in range(m):  # segment-major: each segment's k strips left → right
+            length = float(np.linalg.norm(points[lines[0][t + 1]] - points[lines[0][t]]))
+            for j in range(k):
+                quad = [lines[j][t], lines[j + 1][t], lines[j + 1][t + 1], lines[j][t + 1]]
+                loop2d, rest = _prism(quad, points, thickness)
+                loops.append(np.concatenate([loop2d, loop2d + n_top]))
+                rests.append(rest @ frame)
+                params.append(_hinge_params(widths[e] / k, thickness, target, k,
+                                            sign[pattern.assignments[e]],
+                                            pattern.max_angles[e], exact_arc))
+                vols.append(widths[e] / k * length * thickness)
+                source.append(e)
     vols = np.array(vols)
     src = np.array(source, dtype=np.int64)
     return _group("bending_hinge", loops, rests,

@@ -324,10 +324,7 @@ def unwrapped_fold_angles(pattern, mesh, result) -> np.ndarray:
     """(E,) panel-measured fold angles (degrees), each shifted by a multiple of 360° to
     the side of ±180° its hinge's own bend (Σ of its sub-strips' Eq. 9 angles) is on."""
     bends = np.degrees(estimated_strip_angles(mesh.groups["bending_hinge"], result.positions))
-    hinge = np.full(pattern.n_edges, np.nan)
-    for e, strips in mesh.strips_of_crease.items():
-        hinge[e] = bends[strips].sum()
-    return toward(result.fold_angles_deg, hinge)
+    return toward(result.fold_angles_deg, mesh.crease_bends(bends))
 
 
 def toward(angles, reference) -> np.ndarray:
