@@ -189,8 +189,10 @@ def _strip_lines(pattern, e, width, k, cuts, segments: int = 1):
                         "hinge widths around it; use narrower hinges")
     u = (pb - pa) / length
     n = _left_normal(u)
-    along = np.linspace(cuts[0], length - cuts[1], segments + 1)
-    ends = pa + along[:, None] * u
+    start, stop = pa + cuts[0] * u, pb - cuts[1] * u
+    t_along = np.arange(segments + 1)[:, None] / segments
+    ends = start + t_along * (stop - start)
+    ends[-1] = stop  # exactly the end (the path is compared across units to 1e-9)
     t = 0.5 * width * (1 - 2 * np.arange(k + 1) / k)
     return ends[None, :, :] + t[:, None, None] * n[None, None, :]
 
