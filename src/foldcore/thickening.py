@@ -280,7 +280,9 @@ def thicken(pattern: CreasePattern, thickness: float, hinge_width=None,
         so strips and cells share their points (two plates on one crease must
         agree on the count); the hinge strips must span the plate's sides.
         ``panel_of_face`` names the cell at the middle of its first crease
-        side. ``"auto"`` (for n or either of n1, n2): ⌈side length / ``cell_size``⌉.
+        side. ``"auto"`` (for n or either of n1, n2): ⌈length / ``cell_size``⌉
+        (a plate: the longer of the two sides). ``elastic="plates"``: every
+        quadrilateral face a plate with "auto" counts (other faces stay rigid).
     cell_size : float, optional
         Target cell length (mm) for ``"auto"`` counts.
 
@@ -377,7 +379,14 @@ def _elastic_cells(pattern, loops, elastic, table, cell_size) -> dict:
 
 
 def _split_elastic(pattern, elastic) -> tuple[dict, dict]:
-    """Elastic faces as ({face: n or "auto"} bars, {face: (n1, n2)} plates)."""
+    """Elastic faces as ({face: n or "auto"} bars, {face: (n1, n2)} plates);
+    ``"plates"``: every quadrilateral face a plate with "auto" counts."""
+    if isinstance(elastic, str):
+        if elastic != "plates":
+            raise MeshError(f"{pattern.source}: elastic must be a dict {{face: cells}} or "
+                            f"'plates', got {elastic!r}")
+        return {}, {f: ("auto", "auto") for f, face in enumerate(pattern.faces)
+                    if len(face) == 4}
     bars, plates = {}, {}
     for f, n in dict(elastic or {}).items():
         f = int(f)
@@ -406,7 +415,7 @@ def _plate_counts(pattern, plates, corners, cell_size) -> dict:
         c = np.asarray(corners[f])
         side = np.linalg.norm(np.roll(c, -1, axis=0) - c, axis=1)
         resolved = []
-        for n, length in zip(counts, (0.5 * (side[0] + side[2]), 0.5 * (side[1] + side[3]))):
+        for n, length in zip(counts, (max(side[0], side[2]), max(side[1], side[3]))):
             if isinstance(n, str) and n == "auto":
                 if not (cell_size is not None and np.isfinite(cell_size) and cell_size > 0):
                     raise MeshError(f"{pattern.source}: elastic plate on face {f}: 'auto' "
@@ -480,8 +489,8 @@ def _plate_sides(pattern, f, loop, corners, counts, table) -> list:
         if len(ids) != counts[s] + 1:
             raise MeshError(f"{pattern.source}: elastic plate on face {f}: side {s} has "
                             f"{len(ids) - 2} strip ends inside it, {counts[s] - 1} expected; "
-                            "its hinge strips must span the panel's sides (equal hinge widths "
-                            "around its corners)")
+                            "a plate's hinge strips must end at its corners (square corners "
+                            "with equal hinge widths do; Eq. 1 cuts at other corners do not)")
         sides.append(ids)
     return sides
 
