@@ -28,7 +28,12 @@ corner vertices, α = 1e-2, a soft push) toward the held panel by 0, 5, …,
 from the last. The thick chain is not an exact zero-strain mechanism in the
 strained-joint model (hinge axes sit O(W) off the crease lines, issue 4), so
 the corner does not reach every commanded push: the achieved lengths are
-what is reported. The hinges' 180° limits stop the motion.
+what is reported. The hinges' 180° limits stop the motion. Measured (rigid
+strategy): the deployed chain 23.5 × 122.0 mm (panel-centroid lengths),
+after the stop 8.7 × 79.2 mm from the 50 mm push on; every step converges
+in 2–121 iterations except the one just before the stop (45 mm), where the
+Gauss–Newton steps shrink linearly (a large residual: the corner is 18 mm
+from the soft push target) and the 400-iteration budget ends first.
 
 Quantities: per push, the transverse length (distance between the two
 first-row panels' centroids), the longitudinal length (distance between the
