@@ -57,3 +57,15 @@ def test_the_installed_package_is_stamped():
     package = Path(elements.__file__).parent
     marker = package / "__pycache__" / _cache.STAMP_NAME
     assert marker.read_text() == _cache.sources_digest(package, numba.__version__)
+
+
+def test_a_plugin_tracks_the_helpers_it_calls_through_extra_dirs(tmp_path):
+    plugin, helpers = tmp_path / "plugin", tmp_path / "helpers"
+    plugin.mkdir(), helpers.mkdir()
+    cache = make_package(plugin)
+    (helpers / "rotation.py").write_text("R = 1\n")
+    _cache.drop_stale_kernels(plugin, "0.68.1", extra_dirs=[helpers])
+    (cache / "kernel.batch-3.py311.nbi").write_bytes(b"compiled against R = 1")
+    assert _cache.drop_stale_kernels(plugin, "0.68.1", extra_dirs=[helpers]) == 0
+    (helpers / "rotation.py").write_text("R = 2\n")
+    assert _cache.drop_stale_kernels(plugin, "0.68.1", extra_dirs=[helpers]) == 1

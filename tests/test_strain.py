@@ -117,3 +117,17 @@ def test_render_can_colour_by_strain(tmp_path):
     assert main(["render", str(tmp_path / "waterbomb.fold"), "-o", str(out),
                  "--color-by", "strain", "--size", "320x240"]) == 0
     assert out.stat().st_size > 0
+
+
+def test_accelerated_strategy_checks_limits_when_a_result_is_taken_after_bare_steps():
+    """step() alone does not check (an lbfgs iterate is not a physical state); the
+    state is checked when its result is taken: a hinge driven to 90° against a
+    limit that fails at 45° is reported once the result is read."""
+    pattern, mesh = hinge(90.0, exact_arc=False, assignment="V")
+    sim = Simulation(mesh, pattern, solver="lbfgs",
+                     strain_limits=StrainLimits(tension=eq8_limit(THETA_F)))
+    for _ in range(300):
+        sim.step()
+    assert sim._monitor.failures == []
+    (failure,) = sim.result(False).failures
+    assert failure["mode"] == "tension" and failure["fold_angle_deg"] > THETA_F

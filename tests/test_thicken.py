@@ -933,6 +933,9 @@ def test_plates_on_both_sides_share_the_strip_segments_or_are_refused():
         thicken(vertex, 1.0, elastic={1: (2, 2)})
     with pytest.raises(MeshError, match="stretch hinge"):
         thicken(pattern, 1.0, elastic={1: (2, 2)}, stretch={0: 0.3})
+    with pytest.raises(MeshError, match="elastic bar on face 0 shares edge 0 with the plate "
+                                        "on face 1"):
+        thicken(pattern, 1.0, elastic={0: 3, 1: (2, 3)})
 
 
 def test_plate_folded_by_a_compatible_hinge_stays_flat():

@@ -15,7 +15,12 @@ each kernel compiles once more from the current sources, and the new stamp is
 written. Cost at import: hashing ~30 kB (≈ 0.1 ms).
 
 Scope: the package's in-tree ``__pycache__`` and, when ``NUMBA_CACHE_DIR`` is
-set, the package's folder there (numba's locations for a writable tree). A wheel install does not need it (reinstalling rewrites every
+set, the package's folder there (numba's locations for a writable tree).
+Not covered: a long-running process that imported the old modules and
+compiles a new specialisation after another process stamped the new sources
+(its stale kernel then sits under a matching stamp; restart such sessions
+after editing kernels). Editing any file of the package (even a docstring)
+recompiles every kernel once. A wheel install does not need it (reinstalling rewrites every
 source, which numba sees), an editable checkout does. Kernels outside this
 package (plugins) that call its helpers are not covered: clear their
 ``__pycache__`` after upgrading foldcore (docs/elements.md).
@@ -30,11 +35,13 @@ STAMP_NAME = "foldcore-kernel-sources.sha256"
 NUMBA_SUFFIXES = (".nbi", ".nbc")
 
 
-def sources_digest(package_dir: Path, numba_version: str) -> str:
-    """SHA-256 (hex) over the numba version and each ``*.py`` file's name and bytes."""
+def sources_digest(package_dir: Path, numba_version: str, extra_dirs=()) -> str:
+    """SHA-256 (hex) over the numba version and each ``*.py`` file's name and bytes, in
+    ``package_dir`` and then each of ``extra_dirs`` (folders of helpers it calls)."""
     digest = hashlib.sha256(numba_version.encode())
-    for path in sorted(package_dir.glob("*.py")):
-        digest.update(path.name.encode() + b"\0" + path.read_bytes() + b"\0")
+    for folder in (package_dir, *extra_dirs):
+        for path in sorted(Path(folder).glob("*.py")):
+            digest.update(path.name.encode() + b"\0" + path.read_bytes() + b"\0")
     return digest.hexdigest()
 
 
@@ -46,12 +53,15 @@ def cache_dirs(package_dir: Path) -> list[Path]:
     from numba.core import caching, config
 
     if config.CACHE_DIR:
-        subpath = caching._CacheLocator.get_suitable_cache_subpath(str(package_dir / "x.py"))
+        try:  # numba's private naming of the folder; if it changes, skip that location
+            subpath = caching._CacheLocator.get_suitable_cache_subpath(str(package_dir / "x.py"))
+        except Exception:  # noqa: BLE001 - never break `import elements` over a cache
+            return dirs
         dirs.append(Path(config.CACHE_DIR) / subpath)
     return dirs
 
 
-def drop_stale_kernels(package_dir: Path, numba_version: str) -> int:
+def drop_stale_kernels(package_dir: Path, numba_version: str, extra_dirs=()) -> int:
     """Remove numba cache files built from other sources than the current ones.
 
     Parameters
@@ -60,6 +70,10 @@ def drop_stale_kernels(package_dir: Path, numba_version: str) -> int:
         Directory holding the kernel modules.
     numba_version : str
         Part of the stamp (a new numba recompiles anyway; kept for clarity).
+    extra_dirs : sequence of Path
+        Folders of helpers the kernels call (a plugin passes the ``elements``
+        folder, so a foldcore upgrade that changes ``_rotation`` drops its
+        kernels too).
 
     Returns
     -------
@@ -68,7 +82,7 @@ def drop_stale_kernels(package_dir: Path, numba_version: str) -> int:
         no cache yet). Best effort: unreadable or read-only locations are left
         alone (numba then recompiles into its user-wide cache, keyed per file).
     """
-    stamp = sources_digest(package_dir, numba_version)
+    stamp = sources_digest(package_dir, numba_version, extra_dirs)
     removed = 0
     for folder in cache_dirs(package_dir):
         marker = folder / STAMP_NAME

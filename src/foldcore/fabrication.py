@@ -497,7 +497,8 @@ def _matching_mesh(pattern, thickness, hinge_width, subdivisions, positions, fac
     raise PatternError(f"{source}: the folded frame ({len(positions)} vertices, {len(faces)} "
                        f"faces) matches no thick mesh rebuilt from the file (thickness "
                        f"{thickness:g} mm, {tried}); pass the --subdivisions and "
-                       "--hinge-width used with simulate")
+                       "--hinge-width used with simulate (meshes with elastic panels or "
+                       "stretch hinges cannot be rebuilt from a FOLD file yet)")
 
 
 # ------------------------------------------------------------------- all at once

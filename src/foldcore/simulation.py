@@ -137,8 +137,9 @@ class Simulation:
         other strategies take long steps whose intermediate iterates are not
         physical states (measured: an ``lbfgs`` run of a hinge to 90° bent its
         strips past a 45° limit while its panels read 19°), so they are
-        checked where each run ends: sweep ``set_fold_percent`` to locate a
-        first failure along a path.
+        checked where a result is taken (the end of each ``run``, or
+        :meth:`result`): sweep ``set_fold_percent`` to locate a first
+        failure along a path.
     threads : int, optional
         numba threads for the kernels of this simulation (set at each step,
         so simulations in one process do not override each other). Default:
@@ -408,8 +409,6 @@ class Simulation:
                 break
         self.timings["total"] += time.perf_counter() - start
         self.timings["bare_solve"] = self._bare_solve_floor()
-        if self._monitor is not None and self.solver != "paper":
-            self._monitor.check(self.x, self.iterations, self._percent)
         return self.result(converged)
 
     def _bare_solve_floor(self) -> float:
@@ -463,7 +462,14 @@ class Simulation:
         return strip_strains(g.params, estimated_strip_angles(g, self.x))
 
     def result(self, converged: bool) -> Result:
-        """Snapshot of the current state as a :class:`Result`."""
+        """Snapshot of the current state as a :class:`Result`.
+
+        With strain limits and a strategy other than ``"paper"``, this is
+        where the current state is checked (``run`` ends with it; a loop of
+        bare ``step`` calls is checked when it takes its result).
+        """
+        if self._monitor is not None and self.solver != "paper":
+            self._monitor.check(self.x, self.iterations, self._percent)
         timings = {k: float(v) for k, v in self.timings.items()}
         timings.setdefault("total", sum(timings.values()))
         return Result(self.x.copy(), self.fold_angles(), self.strip_angles(),

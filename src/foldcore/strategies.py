@@ -10,12 +10,12 @@
 """
 SOLVERS = ("paper", "anderson", "lbfgs", "rigid")
 
-#: The default strategy: by issue 4's rule, the fastest one that is robust on
-#: every benchmark scene (bench/convergence, README table). ``lbfgs`` minimises
-#: the paper's own energy, so it reaches the paper's equilibria, and on every
-#: scene it is at least as accurate as ``paper`` at a fraction of the
-#: iterations (hinge Lp/H = 5: 31 vs 10 280; Lp/H ≥ 20: converged where
-#: ``paper`` never gets there); it works with every element type. ``rigid`` is
+#: The default strategy (bench/convergence, README table). No strategy is fast
+#: on every benchmark scene; ``lbfgs`` minimises the paper's own energy, so it
+#: reaches the paper's equilibria, and on every scene it is at least as
+#: accurate as ``paper`` at a fraction of the iterations (hinge Lp/H = 5: 31 vs
+#: 10 280; Lp/H ≥ 20: converged where ``paper`` never gets there; the thin
+#: waterbomb is slow: 0.011° after 40 000); it works with every element type. ``rigid`` is
 #: faster where it applies (rigid panels and bending hinges only) but its
 #: one-arc passive hinge is a different model whose equilibria differ on
 #: passive loops (thick Miura 5×5: 49.7° from the closed form against 9.4°).

@@ -302,7 +302,7 @@ def thicken(pattern: CreasePattern, thickness: float, hinge_width=None,
     corners, corner_ids = _corner_ids(pattern, widths, table)
     bars, plates = _split_elastic(pattern, elastic)
     plates = _plate_counts(pattern, plates, corners, cell_size)
-    segments = _segments(pattern, plates, stretch)
+    segments = _segments(pattern, plates, stretch, bars)
     inserts: list[dict] = [dict() for _ in pattern.faces]
     scale = float(np.ptp(pattern.vertices, axis=0).max())
     strip_points = {}
@@ -429,9 +429,10 @@ def _plate_counts(pattern, plates, corners, cell_size) -> dict:
     return out
 
 
-def _segments(pattern, plates, stretch) -> np.ndarray:
+def _segments(pattern, plates, stretch, bars) -> np.ndarray:
     """(E,) int: prisms along each crease's strip (1; a plate's cell count along its
-    crease sides, so the strip conforms with the cells; 0 for boundary edges)."""
+    crease sides, so the strip conforms with the cells; 0 for boundary edges).
+    A bar (1D cells) cannot share a split crease: refused, naming both faces."""
     segments = np.where(pattern.assignments == "B", 0, 1).astype(np.int64)
     owner = {}
     for f, counts in plates.items():
@@ -448,6 +449,11 @@ def _segments(pattern, plates, stretch) -> np.ndarray:
                 raise MeshError(f"{pattern.source}: elastic plates on faces {owner[e]} and {f} "
                                 f"put {segments[e]} and {n} cells along their shared edge {e}")
             segments[e], owner[e] = n, f
+            other = [g for g in pattern.edge_faces[e] if g != f]
+            if n > 1 and other and int(other[0]) in bars:
+                raise MeshError(f"{pattern.source}: elastic bar on face {int(other[0])} shares "
+                                f"edge {e} with the plate on face {f}, whose {n} cells split "
+                                "the strip; make both plates")
     return segments
 
 

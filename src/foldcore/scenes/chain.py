@@ -12,7 +12,9 @@ spherical mechanisms in a row, each sharing panels with its two neighbours
 only — a linear chain without loops, and with the paper's element counts
 (16 panels; 22 creases × 2 sub-strips = 44 hinge elements). Facets a = 29 mm
 (across the chain), b = 22 mm (along it), γ = 60°, chosen so the deployed
-chain is ≈ 4.6 × 13 cm like the paper's; hinge width W = πH/2 = 4.71 mm, the
+chain's overall extents are ≈ 4.6 × 13 cm like the paper's (measured
+46.4 × 132.4 mm along the sheet's x and y; the reported lengths below are
+panel-centroid distances, hence shorter); hinge width W = πH/2 = 4.71 mm, the
 Eq. 7 minimum for a 180° fold.
 
 Not the paper's pattern in one respect, said plainly: in a Miura strip the
