@@ -11,9 +11,9 @@ reconstruction**: a Miura-ori strip of 2 × 8 parallelogram facets
 spherical mechanisms in a row, each sharing panels with its two neighbours
 only — a linear chain without loops, and with the paper's element counts
 (16 panels; 22 creases × 2 sub-strips = 44 hinge elements). Facets a = 29 mm
-(across the chain), b = 22 mm (along it), γ = 60°, chosen so the deployed
-chain's overall extents are ≈ 4.6 × 13 cm like the paper's (measured
-46.4 × 132.4 mm along the sheet's x and y; the reported lengths below are
+(across the chain), b = 22 mm (along it), γ = 60°, for a chain of about the
+paper's size (deployed, measured along its principal axes: 137.8 × 59.6 ×
+21.2 mm, against the paper's 13 × 4.5 cm; the lengths reported below are
 panel-centroid distances, hence shorter); hinge width W = πH/2 = 4.71 mm, the
 Eq. 7 minimum for a 180° fold.
 
