@@ -122,10 +122,12 @@ def run(quick: bool = False, solver: str | None = None) -> SceneRun:
 
 
 def headline(quantities: dict) -> str:
-    """One line for the demo: the capacity at each thickness beside the thin box."""
-    caps = ", ".join(f"{r['thickness_mm']:g} mm: {r['volume_mm3']['capacity'] / 1e3:.1f}"
-                     for r in quantities["runs"])
-    return f"capacity (cm³) {caps}; thin box {quantities['thin_box_mm3'] / 1e3:.1f}"
+    """One line for the demo: per thickness, the capacity, the walls' flare and the
+    share of the thin tray's capacity at that flare."""
+    return "; ".join(
+        f"H {r['thickness_mm']:g} mm: {r['volume_mm3']['capacity'] / 1e3:.1f} cm³, walls "
+        f"flared {r['wall_tilt_deg']:.1f}°, {r['volume_mm3']['capacity_vs_thin_same_tilt']:.3f}"
+        " of the thin tray" for r in quantities["runs"])
 
 
 def fold(thickness: float, solver: str, budget: int):
