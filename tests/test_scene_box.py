@@ -100,7 +100,8 @@ def test_the_2d_sheets_differ_with_thickness(boxes):
 
 
 def test_scene_run_shows_the_thicker_box(boxes):
-    run, _ = boxes
+    run, rows = boxes
     assert run.name == "box" and run.thickness == max(box.THICKNESSES)
     assert run.result.positions.shape == (run.mesh.n_vertices, 3)
-    assert "capacity" in box.headline(run.quantities)
+    line = box.headline(run.quantities)
+    assert all(f"flared {q['wall_tilt_deg']:.1f}°" in line for q in rows.values())
