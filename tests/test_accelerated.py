@@ -122,3 +122,45 @@ def test_moving_a_position_target_restarts_the_history(solver):
     sim.move_position_target("pull", arc_pose(rest[pulled], 45.0))
     result = sim.run(tolerance=1e-10, max_iterations=20_000)
     assert abs(result.fold_angles_deg[0] - 45.0) < 0.01
+
+
+# ------------------------------------------------------------------ hybrid
+@pytest.mark.parametrize("ratio", [5.0, 20.0, 80.0, 320.0])
+def test_hybrid_reaches_the_hinge_target_in_a_flat_number_of_iterations(ratio):
+    """Issue 4's target for the default strategy: 0.01° within 50 iterations at every
+    Lp/H up to 320 (the rigid phase's count does not grow with panel length)."""
+    pattern, mesh = hinge(ratio)
+    result = Simulation(mesh, pattern, solver="hybrid").run(tolerance=1e-10,
+                                                             max_iterations=50)
+    assert abs(result.fold_angles_deg[0] - 90.0) <= 0.01
+
+
+def test_hybrid_ends_at_a_fixed_point_of_the_papers_map():
+    """After its rigid phase it polishes with L-BFGS on the paper's energy, so where it
+    stops the paper's own step barely moves (≤ 10× the run's tolerance, the slack of
+    a stopping rule on step size)."""
+    vertex = patterns.degree4_vertex(radius=20.0, widths=[2.0] * 4, rho1=60.0)
+    mesh = thicken(vertex, 1.0, subdivisions=2)
+    hybrid = Simulation(mesh, vertex, solver="hybrid")
+    result = hybrid.run(tolerance=1e-9, max_iterations=20_000)
+    assert result.converged
+    paper = Simulation(mesh, vertex, solver="paper")
+    paper.set_positions(result.positions)
+    assert paper.step() <= 10 * 1e-9 * paper.length_scale
+
+
+def test_hybrid_restarts_its_rigid_phase_when_targets_move_and_falls_back_on_cells():
+    pattern, mesh = hinge(80.0)
+    sim = Simulation(mesh, pattern, solver="hybrid")
+    sim.run(tolerance=1e-10, max_iterations=50)
+    sim.set_fold_angles({0: 45.0})
+    before = sim.iterations
+    result = sim.run(tolerance=1e-10, max_iterations=50)
+    assert abs(result.fold_angles_deg[0] - 45.0) <= 0.01 and result.iterations - before < 50
+    # elastic cells share vertices, which the rigid phase cannot take: plain L-BFGS
+    bar = patterns.single_hinge(panel_length=10.0, depth=10.0, angle=60.0, width=2.0)
+    cells = thicken(bar, 1.0, subdivisions=2, elastic={1: 3})
+    runs = [Simulation(cells, bar, solver=s).run(tolerance=1e-10, max_iterations=300)
+            for s in ("hybrid", "lbfgs")]
+    assert runs[0].iterations == runs[1].iterations
+    np.testing.assert_array_equal(runs[0].positions, runs[1].positions)

@@ -109,7 +109,8 @@ def build_parser() -> argparse.ArgumentParser:
                           "anderson (the same map, safeguarded Anderson acceleration), lbfgs "
                           "(L-BFGS on the same energy, K as initial Hessian) or rigid "
                           "(panels as rigid bodies, Levenberg-Marquardt; far fewer iterations "
-                          "on long panels, rigid panels only); default: " + DEFAULT_SOLVER)
+                          "on long panels, rigid panels only) or hybrid (rigid steps, then "
+                          "lbfgs on the paper's energy); default: " + DEFAULT_SOLVER)
     sim.add_argument("--tolerance", type=_positive, default=1e-8,
                      help="stop when the largest step is below this × pattern size")
     sim.add_argument("--max-iterations", type=int, default=10_000)

@@ -24,6 +24,8 @@ STOP_LEAVE = 1e-3  # rad back inside its interval before a stop is released
 # 2-core Xeon, paper map, ms/iteration 1 vs 2 threads: Miura 2×2 (108 slots) 0.070 vs
 # 0.063 quiet / 2.3 with the cores busy; 5×5 (936) 0.41 vs 0.28; 10×10 (4 076) 1.77 vs 1.09.
 SERIAL_BELOW_SLOTS = 500
+HYBRID_RIGID_MAX = 200    # rigid-body steps at most per run of solver="hybrid"
+HYBRID_RIGID_TOL = 1e-10  # relative step below which its rigid phase ends (even at tolerance 0)
 BARE_SOLVE_REPEATS = 5  # solves timed for the per-iteration cost floor
 
 
@@ -101,9 +103,12 @@ class Simulation:
     mesh : ThickMesh
     pattern : CreasePattern
         The pattern the mesh was made from (targets, assignments, measurement).
-    solver : {"lbfgs", "paper", "anderson", "rigid"}
-        Iteration strategy, default ``"lbfgs"`` (why:
-        :data:`foldcore.strategies.DEFAULT_SOLVER`). ``"paper"``: the paper's plain local/global map
+    solver : {"hybrid", "lbfgs", "paper", "anderson", "rigid"}
+        Iteration strategy, default ``"hybrid"`` (why:
+        :data:`foldcore.strategies.DEFAULT_SOLVER`): each ``run`` starts with
+        up to 200 ``"rigid"`` steps and continues with ``"lbfgs"`` from where
+        they stop (bare :meth:`step` calls are L-BFGS steps; a mesh the rigid
+        strategy cannot take runs L-BFGS alone). ``"paper"``: the paper's plain local/global map
         (every element a soft spring; iterations grow with panel length /
         thickness). ``"anderson"``/``"lbfgs"``: the same local step and K,
         accelerated (safeguarded Anderson; L-BFGS with K as initial Hessian,
@@ -184,11 +189,12 @@ class Simulation:
         self._monitor = self._failure_monitor(strain_limits)
         self._bare_solve = None  # (K version, seconds) of the last bare-solve timing
         self._rigid = self._accelerated = None
+        self._rigid_phase = solver == "hybrid"  # next run() starts with rigid-body steps
         if solver == "rigid":
             from .rigid_body import RigidBodySolver
             self._rigid = RigidBodySolver(self)
             self.x = self._rigid.x
-        elif solver in ("anderson", "lbfgs"):
+        elif solver in ("anderson", "lbfgs", "hybrid"):
             from .accelerated import AndersonSolver, LbfgsSolver
             self._accelerated = (AndersonSolver if solver == "anderson" else LbfgsSolver)(self)
 
@@ -398,7 +404,12 @@ class Simulation:
         start = time.perf_counter()
         converged = False
         self.timings.setdefault("total", self.timings["setup"])
-        for _ in range(int(max_iterations)):
+        budget = int(max_iterations)
+        if self._rigid_phase:
+            budget, stopped = self._hybrid_rigid_phase(tolerance, budget, callback)
+            if stopped:
+                budget = 0
+        for _ in range(budget):
             moved = self.step()
             if not np.isfinite(moved):
                 raise SimulationError("the iteration produced non-finite positions")
@@ -410,6 +421,38 @@ class Simulation:
         self.timings["total"] += time.perf_counter() - start
         self.timings["bare_solve"] = self._bare_solve_floor()
         return self.result(converged)
+
+    def _hybrid_rigid_phase(self, tolerance: float, budget: int, callback) -> tuple[int, bool]:
+        """``solver="hybrid"``: rigid-body Levenberg–Marquardt steps from the current
+        positions until they stop moving (≤ max(tolerance, HYBRID_RIGID_TOL) × size)
+        or HYBRID_RIGID_MAX steps, then L-BFGS continues from there on the paper's
+        energy. Returns (iterations left, whether the callback stopped the run).
+        Meshes the rigid strategy cannot take (elastic cells, other element types)
+        go straight to L-BFGS."""
+        from .rigid_body import RigidBodySolver
+
+        self._rigid_phase = False
+        try:
+            self._rigid = RigidBodySolver(self)
+        except SimulationError:
+            return budget, False
+        self.x = self._rigid.x
+        stop_at = max(tolerance, HYBRID_RIGID_TOL) * self.length_scale
+        used, stopped = 0, False
+        while used < min(budget, HYBRID_RIGID_MAX):
+            moved = self.step()
+            used += 1
+            if not np.isfinite(moved):
+                raise SimulationError("the iteration produced non-finite positions")
+            if callback is not None and callback(self, moved) is False:
+                stopped = True
+                break
+            if moved <= stop_at:
+                break
+        self._rigid = None
+        self.x = np.ascontiguousarray(self.x.copy())
+        self._accelerated.restart(self.x)
+        return budget - used, stopped
 
     def _bare_solve_floor(self) -> float:
         """:meth:`bare_solve_seconds`, timed once per factorisation of K (a sweep of
@@ -479,9 +522,12 @@ class Simulation:
 
     # --------------------------------------------------------------- private
     def _targets_changed(self) -> None:
-        """Targets moved: an accelerated strategy's history (energies, gradients) is stale."""
+        """Targets moved: an accelerated strategy's history (energies, gradients) is stale;
+        ``hybrid`` starts its next run with rigid-body steps again."""
         if self._accelerated is not None:
             self._accelerated.restart(self.x)
+        if self.solver == "hybrid":
+            self._rigid_phase = True
 
     def _check_every_vertex_used(self) -> None:
         """A vertex in no element has no equation: K would be singular there."""
