@@ -21,5 +21,8 @@ SOLVERS = ("paper", "anderson", "lbfgs", "rigid", "hybrid")
 #: on the paper's own energy, so it ends at the paper model's equilibria
 #: (passive creases: Eq. 9 per sub-strip), with every element type (meshes
 #: the rigid phase cannot take run L-BFGS alone). On every benchmark scene it
-#: is at least as close to the closed form as ``lbfgs`` and ``paper``.
+#: is at least as close to the closed form as ``lbfgs`` and ``paper``. Cost:
+#: a rigid step is a sparse Gauss–Newton solve, ~10–13 µs per thick vertex
+#: (Miura 20×20, 7.8 k vertices: 78 ms; 50×50, 49.6 k: 0.62 s, measured), so on
+#: large meshes whose rigid phase needs many steps ``lbfgs`` can be quicker.
 DEFAULT_SOLVER = "hybrid"
