@@ -164,3 +164,35 @@ def test_hybrid_restarts_its_rigid_phase_when_targets_move_and_falls_back_on_cel
             for s in ("hybrid", "lbfgs")]
     assert runs[0].iterations == runs[1].iterations
     np.testing.assert_array_equal(runs[0].positions, runs[1].positions)
+
+
+def test_hybrid_survives_an_interrupted_rigid_phase_and_keeps_given_positions():
+    """An exception inside the rigid phase (here the callback's) leaves the simulation
+    in its L-BFGS phase; positions set by the user are continued from, not refitted
+    (a restart from a converged state moves < 1e-6 mm); a rigid phase that meets the
+    tolerance on the budget's last iteration is reported converged."""
+    pattern, mesh = hinge(20.0)
+    sim = Simulation(mesh, pattern, solver="hybrid")
+
+    def interrupt(s, moved):
+        if s.iterations == 2:
+            raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        sim.run(tolerance=1e-10, max_iterations=50, callback=interrupt)
+    assert sim._rigid is None and not sim._rigid_phase
+    done = sim.run(tolerance=1e-10, max_iterations=2_000)
+    assert done.converged and abs(done.fold_angles_deg[0] - 90.0) <= 0.01
+    again = Simulation(mesh, pattern, solver="hybrid")
+    again.set_positions(done.positions)
+    restart = again.run(tolerance=1e-10, max_iterations=2_000)
+    assert np.abs(restart.positions - done.positions).max() < 1e-6
+    in_rigid_phase = []
+    Simulation(mesh, pattern, solver="hybrid").run(
+        tolerance=1e-8, max_iterations=200,
+        callback=lambda s, moved: in_rigid_phase.append(s._rigid is not None))
+    rigid_steps = sum(in_rigid_phase)
+    assert 0 < rigid_steps < len(in_rigid_phase)
+    exact = Simulation(mesh, pattern, solver="hybrid").run(tolerance=1e-8,
+                                                           max_iterations=rigid_steps)
+    assert exact.iterations == rigid_steps and exact.converged

@@ -62,8 +62,8 @@ def test_simulate_writes_report_and_fold_of_the_contract(fold_file, tmp_path):
 
 def test_not_converging_is_a_result_with_a_warning(fold_file, tmp_path, capsys):
     out, report = tmp_path / "out.fold", tmp_path / "r.json"
-    code = main(["simulate", str(fold_file), "--max-iterations", "5", "-o", str(out),
-                 "--report", str(report)])
+    code = main(["simulate", str(fold_file), "--solver", "paper", "--max-iterations", "5",
+                 "-o", str(out), "--report", str(report)])
     assert code == 0
     assert json.loads(report.read_text())["converged"] is False
     assert "not converged" in capsys.readouterr().err

@@ -108,7 +108,11 @@ class Simulation:
         :data:`foldcore.strategies.DEFAULT_SOLVER`): each ``run`` starts with
         up to 200 ``"rigid"`` steps and continues with ``"lbfgs"`` from where
         they stop (bare :meth:`step` calls are L-BFGS steps; a mesh the rigid
-        strategy cannot take runs L-BFGS alone). ``"paper"``: the paper's plain local/global map
+        strategy cannot take runs L-BFGS alone). Its rigid phase reaches
+        position targets within a few iterations, before a ``decay`` < 1
+        (counted in iterations) has faded them: for a pull-and-release
+        schedule use ``"lbfgs"`` or ``"paper"``. ``energy_history`` joins
+        the rigid phase's energy and the paper's. ``"paper"``: the paper's plain local/global map
         (every element a soft spring; iterations grow with panel length /
         thickness). ``"anderson"``/``"lbfgs"``: the same local step and K,
         accelerated (safeguarded Anderson; L-BFGS with K as initial Hessian,
@@ -300,7 +304,8 @@ class Simulation:
 
         For restarting from a saved or perturbed state; the targets, stops and
         pins are unchanged. Not available with ``solver="rigid"``, whose state
-        is its panels' rigid motions.
+        is its panels' rigid motions; with ``"hybrid"`` the next run continues
+        from them with L-BFGS (no rigid phase, which would refit the panels).
         """
         x = np.asarray(positions, dtype=float)
         if x.shape != self.x.shape or not np.isfinite(x).all():
@@ -310,6 +315,7 @@ class Simulation:
             raise SimulationError("solver 'rigid' keeps its panels rigid by construction: "
                                   "its positions cannot be set")
         self.x = np.ascontiguousarray(x.copy())
+        self._rigid_phase = False  # hybrid: continue from these positions with L-BFGS
         if self._accelerated is not None:
             self._accelerated.restart(self.x)
 
@@ -405,10 +411,11 @@ class Simulation:
         converged = False
         self.timings.setdefault("total", self.timings["setup"])
         budget = int(max_iterations)
-        if self._rigid_phase:
-            budget, stopped = self._hybrid_rigid_phase(tolerance, budget, callback)
+        if self._rigid_phase and budget > 0:
+            budget, stopped, converged = self._hybrid_rigid_phase(tolerance, budget, callback)
             if stopped:
                 budget = 0
+            converged = converged and budget == 0
         for _ in range(budget):
             moved = self.step()
             if not np.isfinite(moved):
@@ -422,37 +429,42 @@ class Simulation:
         self.timings["bare_solve"] = self._bare_solve_floor()
         return self.result(converged)
 
-    def _hybrid_rigid_phase(self, tolerance: float, budget: int, callback) -> tuple[int, bool]:
+    def _hybrid_rigid_phase(self, tolerance: float, budget: int,
+                            callback) -> tuple[int, bool, bool]:
         """``solver="hybrid"``: rigid-body Levenberg–Marquardt steps from the current
         positions until they stop moving (≤ max(tolerance, HYBRID_RIGID_TOL) × size)
         or HYBRID_RIGID_MAX steps, then L-BFGS continues from there on the paper's
-        energy. Returns (iterations left, whether the callback stopped the run).
-        Meshes the rigid strategy cannot take (elastic cells, other element types)
-        go straight to L-BFGS."""
+        energy. Returns (iterations left, whether the callback stopped the run,
+        whether the last step met ``tolerance``). Meshes the rigid strategy cannot
+        take (elastic cells, other element types) go straight to L-BFGS. Whatever
+        ends the phase (an exception, an interrupt included), the simulation is
+        left in its L-BFGS phase."""
         from .rigid_body import RigidBodySolver
 
         self._rigid_phase = False
         try:
             self._rigid = RigidBodySolver(self)
         except SimulationError:
-            return budget, False
-        self.x = self._rigid.x
+            return budget, False, False
         stop_at = max(tolerance, HYBRID_RIGID_TOL) * self.length_scale
-        used, stopped = 0, False
-        while used < min(budget, HYBRID_RIGID_MAX):
-            moved = self.step()
-            used += 1
-            if not np.isfinite(moved):
-                raise SimulationError("the iteration produced non-finite positions")
-            if callback is not None and callback(self, moved) is False:
-                stopped = True
-                break
-            if moved <= stop_at:
-                break
-        self._rigid = None
-        self.x = np.ascontiguousarray(self.x.copy())
-        self._accelerated.restart(self.x)
-        return budget - used, stopped
+        used, stopped, moved = 0, False, np.inf
+        try:
+            self.x = self._rigid.x
+            while used < min(budget, HYBRID_RIGID_MAX):
+                moved = self.step()
+                used += 1
+                if not np.isfinite(moved):
+                    raise SimulationError("the iteration produced non-finite positions")
+                if callback is not None and callback(self, moved) is False:
+                    stopped = True
+                    break
+                if moved <= stop_at:
+                    break
+        finally:
+            self._rigid = None
+            self.x = np.ascontiguousarray(self.x.copy())
+            self._accelerated.restart(self.x)
+        return budget - used, stopped, moved <= tolerance * self.length_scale
 
     def _bare_solve_floor(self) -> float:
         """:meth:`bare_solve_seconds`, timed once per factorisation of K (a sweep of
