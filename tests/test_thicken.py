@@ -960,11 +960,12 @@ def test_plate_folded_by_a_compatible_hinge_stays_flat():
     assert mesh.crease_bends(result.strip_angles_deg)[0] == pytest.approx(90.0, abs=1e-3)
 
 
-def test_every_quad_face_a_plate_on_a_grid_and_a_clear_refusal_on_a_miura():
+def test_every_quad_face_a_plate_on_a_grid_and_on_a_miura():
     """elastic="plates": a 3 × 2 grid of 20 mm squares with cells of ≤ 5 mm: 4 × 4 cells
     per face, every crease split into 4 segments, conforming. A Miura sheet's strips
-    stop short of its parallelograms' corners (Eq. 1 cuts at acute/obtuse corners),
-    so the cells cannot conform with a uniform grid: refused, naming face and side."""
+    stop short of its parallelograms' acute/obtuse corners (Eq. 1 cuts): the gap
+    becomes an extra grid column (or a triangle where the opposite side has none);
+    still conforming, counter-clockwise, and the same volume as the undivided mesh."""
     grid = patterns.grid(3, 2, size=20.0, assignment="V")
     mesh = thicken(grid, 1.0, hinge_width=2.0, subdivisions=2, elastic="plates", cell_size=5.0)
     assert len(mesh.groups["rigid_panel"]) == 6 * 16
@@ -972,8 +973,12 @@ def test_every_quad_face_a_plate_on_a_grid_and_a_clear_refusal_on_a_miura():
     sheet = mesh.groups["rigid_panel"].volumes.sum() + mesh.groups["bending_hinge"].volumes.sum()
     plain = thicken(grid, 1.0, hinge_width=2.0, subdivisions=2)
     assert sheet == pytest.approx(plain.volume())
-    miura = patterns.miura(2, 2, a=20.0, b=20.0, gamma=60.0, width=2.0)
-    with pytest.raises(MeshError, match=r"face 0: side \d has \d strip ends inside it"):
-        thicken(miura, 1.0, subdivisions=2, elastic="plates", cell_size=5.0)
+    miura = patterns.miura(3, 3, a=20.0, b=20.0, gamma=60.0, width=2.0)
+    plates = thicken(miura, 1.0, subdivisions=2, elastic="plates", cell_size=5.0)
+    assert not hanging_points(plates)
+    assert all(shoelace(plates.points[p.top]) > 0 for p in prisms_of(plates))
+    assert plates.volume() == pytest.approx(thicken(miura, 1.0, subdivisions=2).volume())
+    cells = [p for p in prisms_of(plates) if p.kind == "rigid_panel"]
+    assert len(cells) > 9 * 16 and {len(p.top) for p in cells} <= {3, 4}
     with pytest.raises(MeshError, match="elastic must be a dict"):
         thicken(grid, 1.0, elastic="cells")

@@ -278,7 +278,9 @@ def thicken(pattern: CreasePattern, thickness: float, hinge_width=None,
         vertex); any number of its sides may be creases, whose strips are then
         split into as many segments along the crease (``ThickMesh.segments``)
         so strips and cells share their points (two plates on one crease must
-        agree on the count); the hinge strips must span the plate's sides.
+        agree on the count); where a strip stops short of a corner (Eq. 1 cuts
+        at acute/obtuse corners) the gap adds a column of cells, or a triangle
+        where the opposite side has no gap.
         ``panel_of_face`` names the cell at the middle of its first crease
         side. ``"auto"`` (for n or either of n1, n2): ⌈length / ``cell_size``⌉
         (a plate: the longer of the two sides). ``elastic="plates"``: every
@@ -314,7 +316,9 @@ def thicken(pattern: CreasePattern, thickness: float, hinge_width=None,
         strip_points[int(e)] = [sides[0]] + inner + [sides[ks[e]]]
     loops = _panel_loops(corner_ids, inserts)
     cells = _elastic_cells(pattern, loops, bars, table, cell_size)
-    cells.update(_plate_cells(pattern, loops, corner_ids, plates, table))
+    pieces = {frozenset(pair) for lines in strip_points.values() for side in (lines[0], lines[-1])
+              for pair in zip(side, side[1:])}
+    cells.update(_plate_cells(pattern, loops, corner_ids, plates, table, pieces))
     points = np.array(table.coords)
     stiff = stiffness or {}
     panels, panel_of_face = _panel_group(pattern, points, loops, cells, thickness,
@@ -457,48 +461,148 @@ def _segments(pattern, plates, stretch, bars) -> np.ndarray:
     return segments
 
 
-def _plate_cells(pattern, loops, corner_ids, plates, table) -> dict:
-    """{face: [cell loops]}: each plate an n1 × n2 grid of quads (bilinear in its inset
-    corners), its crease sides sharing the split strips' points; the cell at
-    the middle of its first crease side comes first (it measures the face)."""
+def _plate_cells(pattern, loops, corner_ids, plates, table, strip_pieces) -> dict:
+    """{face: [cell loops]}: each plate a grid of quads conforming with its outline.
+
+    The outline's four geometric corners split it into sides; a side's points
+    (its corners, the ends and segment points of the strip along it) become
+    grid points. Opposite sides get equal counts: a boundary side takes the
+    positions of the one opposite; a crease side whose strip stops short of a
+    corner (Eq. 1 cuts at acute/obtuse corners) has a gap there, split as
+    needed. Interior points: Coons patch of the four sides. The cell at the
+    middle of the first crease side comes first (it measures the face).
+    """
     cells = {}
-    for f, (n1, n2) in plates.items():
-        sides = _plate_sides(pattern, f, loops[f], corner_ids[f], (n1, n2, n1, n2), table)
-        c = np.array([table.coords[i] for i in corner_ids[f]])
-        grid = np.empty((n1 + 1, n2 + 1), dtype=np.int64)
-        grid[:, 0], grid[n1, :] = sides[0], sides[1]
-        grid[:, n2], grid[0, :] = sides[2][::-1], sides[3][::-1]
-        for i in range(1, n1):
-            for j in range(1, n2):
-                u, v = i / n1, j / n2
-                grid[i, j] = table.add((1 - u) * (1 - v) * c[0] + u * (1 - v) * c[1]
-                                       + u * v * c[2] + (1 - u) * v * c[3])
-        quads = {(i, j): [grid[i, j], grid[i + 1, j], grid[i + 1, j + 1], grid[i, j + 1]]
+    for f, counts in plates.items():
+        sides = _plate_sides(pattern, f, loops[f], corner_ids[f], table, strip_pieces, counts)
+        grid = _coons_grid(sides, table)
+        n1, n2 = grid.shape[0] - 1, grid.shape[1] - 1
+        quads = {(i, j): _distinct([grid[i, j], grid[i + 1, j], grid[i + 1, j + 1],
+                                    grid[i, j + 1]])
                  for i in range(n1) for j in range(n2)}
+        for key, quad in quads.items():
+            if _polygon_area(np.array([table.coords[k] for k in quad])) <= 0:
+                raise MeshError(f"{pattern.source}: elastic plate on face {f}: cell {key} of "
+                                "its grid is folded over (outline too far from a "
+                                "quadrilateral); use fewer cells")
         first = _measuring_cell(pattern, f, n1, n2)
         cells[f] = [quads[first]] + [q for key, q in quads.items() if key != first]
     return cells
 
 
-def _plate_sides(pattern, f, loop, corners, counts, table) -> list:
-    """Point ids along each side of a plate's loop, corner to corner (n + 1 each);
-    boundary sides get evenly spaced new points."""
-    at = [loop.index(c) for c in corners]
+def _distinct(loop: list) -> list:
+    """A cell loop without repeated points (a corner where two grid lines meet makes
+    a quad a triangle)."""
+    return [p for k, p in enumerate(loop) if p != loop[k - 1]]
+
+
+def _plate_sides(pattern, f, loop, corners, table, strip_pieces, counts) -> list:
+    """Point ids along the four sides of a plate's outline, geometric corner to
+    corner, opposite sides with equal counts (see :func:`_plate_cells`); two
+    opposite sides without strip points are cut into their count (n1 or n2)
+    of equal pieces."""
+    xy = np.array([table.coords[i] for i in loop])
+    turn = _cross(xy - np.roll(xy, 1, axis=0), np.roll(xy, -1, axis=0) - xy)
+    scale = float(np.ptp(xy, axis=0).max())
+    bends = np.flatnonzero(np.abs(turn) > 1e-9 * scale ** 2)
+    if len(bends) != 4:
+        raise MeshError(f"{pattern.source}: elastic plate on face {f}: its inset outline has "
+                        f"{len(bends)} corners, a grid needs 4")
+    inset = np.array([table.coords[c] for c in corners])
+    order = [int(bends[np.argmin(np.linalg.norm(xy[bends] - c, axis=1))]) for c in inset]
+    if len(set(order)) != 4:
+        raise MeshError(f"{pattern.source}: elastic plate on face {f}: cannot match its "
+                        "outline's corners to the face's")
     sides = []
     for s in range(4):
-        stop = at[(s + 1) % 4] if s < 3 else len(loop)
-        ids = loop[at[s]:stop] + [corners[(s + 1) % 4]]
-        if len(ids) == 2 and counts[s] > 1:
-            p, q = table.coords[ids[0]], table.coords[ids[1]]
-            ids = [ids[0]] + [table.add(p + t * (q - p)) for t in
-                              np.arange(1, counts[s]) / counts[s]] + [ids[1]]
-        if len(ids) != counts[s] + 1:
-            raise MeshError(f"{pattern.source}: elastic plate on face {f}: side {s} has "
-                            f"{len(ids) - 2} strip ends inside it, {counts[s] - 1} expected; "
-                            "a plate's hinge strips must end at its corners (square corners "
-                            "with equal hinge widths do; Eq. 1 cuts at other corners do not)")
-        sides.append(ids)
+        a, b = order[s], order[(s + 1) % 4]
+        sides.append([loop[(a + k) % len(loop)] for k in range((b - a) % len(loop) + 1)])
+    bare = [len(side) == 2 for side in sides]
+    for s in range(4):  # two opposite sides without strip points: equal pieces
+        n = counts[s % 2]
+        if bare[s] and bare[(s + 2) % 4] and n > 1:
+            p, q = table.coords[sides[s][0]], table.coords[sides[s][1]]
+            sides[s] = [sides[s][0]] + [table.add(p + t * (q - p))
+                                        for t in np.arange(1, n) / n] + [sides[s][1]]
+    for s in (0, 1):
+        sides[s], sides[s + 2] = _equal_counts(pattern, f, s, sides[s], sides[s + 2], table,
+                                               strip_pieces)
     return sides
+
+
+def _equal_counts(pattern, f, s, near, far, table, strip_pieces) -> tuple[list, list]:
+    """Opposite sides (``far`` runs the other way) with as many points each: a side
+    without a strip copies the other's positions; otherwise the gaps between a
+    corner and a strip end are split (the longest first); a side without gaps
+    repeats the corner facing the other's gap (its cells there are triangles)."""
+    face = pattern.faces[f]
+    strip = [pattern.assignments[_edge_of(pattern, face[k], face[(k + 1) % 4])] != "B"
+             for k in (s, s + 2)]
+    far_fwd = far[::-1]
+    for _ in range(4 * (len(near) + len(far))):
+        if len(near) == len(far_fwd):
+            return near, far_fwd[::-1]
+        short_is_near = len(near) < len(far_fwd)
+        short, long_, short_strip = ((near, far_fwd, strip[0]) if short_is_near
+                                     else (far_fwd, near, strip[1]))
+        refined = _refined(short, long_, short_strip, table, strip_pieces)
+        if refined is None:  # no gap to split: the long side's extra piece meets a corner
+            gap_first = frozenset((long_[0], long_[1])) not in strip_pieces
+            refined = [short[0]] + short if gap_first else short + [short[-1]]
+        short = refined
+        near, far_fwd = (short, far_fwd) if short_is_near else (near, short)
+    raise MeshError(f"{pattern.source}: elastic plate on face {f}: cannot even sides {s} "
+                    f"and {s + 2}")
+
+
+def _refined(side, other, has_strip, table, strip_pieces):
+    """``side`` with one more point: at the other side's next relative position if it
+    has no strip, else splitting its longest end gap; None if it cannot."""
+    pts = np.array([table.coords[i] for i in side])
+    if not has_strip:
+        q = np.array([table.coords[i] for i in other])
+        t = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(q, axis=0), axis=1))]
+        t /= t[-1]
+        p0, p1 = pts[0], pts[-1]
+        return [side[0]] + [table.add(p0 + u * (p1 - p0)) for u in t[1:-1]] + [side[-1]]
+    ends = [(float(np.linalg.norm(pts[1] - pts[0])), 0),
+            (float(np.linalg.norm(pts[-1] - pts[-2])), len(side) - 2)]
+    ends = [(length, k) for length, k in ends if len(side) > 2 and length > 0]
+    gaps = [(length, k) for length, k in ends
+            if frozenset((side[k], side[k + 1])) not in strip_pieces]
+    if not gaps:
+        return None
+    _, k = max(gaps)
+    middle = table.add(0.5 * (pts[k] + pts[k + 1]))
+    return side[:k + 1] + [middle] + side[k + 1:]
+
+
+def _coons_grid(sides, table) -> np.ndarray:
+    """(n1 + 1, n2 + 1) point ids: the four sides on the border, interior points by a
+    Coons patch of the sides over their chord-length parameters."""
+    b0 = np.array([table.coords[i] for i in sides[0]])
+    b1 = np.array([table.coords[i] for i in sides[1]])
+    b2 = np.array([table.coords[i] for i in sides[2][::-1]])
+    b3 = np.array([table.coords[i] for i in sides[3][::-1]])
+    n1, n2 = len(b0) - 1, len(b1) - 1
+
+    def params(points):
+        t = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))]
+        return t / t[-1]
+
+    u = 0.5 * (params(b0) + params(b2))
+    v = 0.5 * (params(b3) + params(b1))
+    c0, c1, c2, c3 = b0[0], b0[-1], b2[-1], b2[0]
+    grid = np.empty((n1 + 1, n2 + 1), dtype=np.int64)
+    grid[:, 0], grid[n1, :] = sides[0], sides[1]
+    grid[:, n2], grid[0, :] = sides[2][::-1], sides[3][::-1]
+    for i in range(1, n1):
+        for j in range(1, n2):
+            p = ((1 - v[j]) * b0[i] + v[j] * b2[i] + (1 - u[i]) * b3[j] + u[i] * b1[j]
+                 - ((1 - u[i]) * (1 - v[j]) * c0 + u[i] * (1 - v[j]) * c1
+                    + u[i] * v[j] * c2 + (1 - u[i]) * v[j] * c3))
+            grid[i, j] = table.add(p)
+    return grid
 
 
 def _measuring_cell(pattern, f: int, n1: int, n2: int) -> tuple[int, int]:
