@@ -207,6 +207,36 @@ def test_read_result_finds_explicit_subdivisions(tmp_path):
     assert res.footprint_misfit_mm < 1e-9
 
 
+def test_a_result_with_elastic_panels_reads_back_and_exports(tmp_path, capsys):
+    """foldcore:faces_cells carries the cell counts, so the bar and plate cells are
+    rebuilt (same mesh, same positions) and the folded solid exports watertight; a
+    malformed entry is refused naming the face, exit code 2 from the CLI."""
+    from foldcore.outputs import write_result
+    from foldcore.simulation import Simulation
+    from foldcore.thickening import thicken
+
+    pattern = patterns.single_hinge(panel_length=20.0, depth=20.0, angle=60.0, width=2.0)
+    for elastic in ({1: 3}, {0: (3, 2), 1: (4, 3)}):
+        mesh = thicken(pattern, 1.0, subdivisions=2, elastic=elastic)
+        result = Simulation(mesh, pattern).run(tolerance=1e-9, max_iterations=2_000)
+        path = tmp_path / "plate.fold"
+        write_result(result, pattern, mesh, 1.0, {}, fold=path)
+        back = read_result(path)
+        assert back.mesh.elastic == elastic
+        assert back.mesh.n_vertices == mesh.n_vertices
+        assert back.positions == pytest.approx(result.positions, abs=1e-12)
+    stl = tmp_path / "plate.stl"
+    assert main(["export", str(path), "--stl", str(stl)]) == 0 and stl.exists()
+    edited = json.loads(path.read_text())
+    edited["foldcore:faces_cells"][1] = [4, 0]
+    bad = tmp_path / "bad.fold"
+    bad.write_text(json.dumps(edited))
+    assert main(["export", str(bad), "--stl", str(tmp_path / "bad.stl")]) == 2
+    err = capsys.readouterr().err
+    assert "bad.fold" in err and "foldcore:faces_cells[1] (face 1)" in err
+    assert not (tmp_path / "bad.stl").exists()
+
+
 def _bad_export_inputs(result_fold, tmp_path):
     from foldcore.io import write_fold
 

@@ -359,9 +359,10 @@ class ResultFile:
     thickness : float
         mm.
     footprint_misfit_mm : float
-        Largest RMS distance between a panel's rebuilt flat shape, best-fit
-        rotated, and its folded shape (mm); small when the rebuilt hinge
-        widths are those simulated (panels are rigid).
+        Largest RMS distance between a rigid panel's rebuilt flat shape,
+        best-fit rotated, and its folded shape (mm); small when the rebuilt
+        hinge widths are those simulated (elastic cells, which deform, are
+        left out).
     source : str
     """
 
@@ -416,7 +417,7 @@ def read_result(path, hinge_width=None, subdivisions=None) -> ResultFile:
         Unreadable or malformed file, no folded frame, no thickness, or no
         rebuilt mesh matching the stored faces.
     """
-    from .io.fold import _parse_json, fold_file_from_dict, read_bytes
+    from .io.fold import _parse_json, faces_cells, fold_file_from_dict, read_bytes
     from .measure import element_rotations
 
     source = os.fspath(path)
@@ -425,12 +426,15 @@ def read_result(path, hinge_width=None, subdivisions=None) -> ResultFile:
     positions, faces = _folded_frame(d, source)
     if fold.thickness is None:
         raise PatternError(f"{source}: no foldcore:thickness; not a foldcore result file")
+    elastic = faces_cells(d, len(fold.pattern.faces), source)
     mesh = _matching_mesh(fold.pattern, fold.thickness, hinge_width, subdivisions,
-                          positions, faces, source)
+                          positions, faces, source, elastic)
     panels = mesh.groups[mesh.panel_group]
     rot = element_rotations(panels, positions)
     misfit = 0.0
     for e in range(len(panels)):
+        if int(panels.source[e]) in mesh.elastic:
+            continue  # elastic cells deform by design: only rigid panels test the widths
         s = panels.slots(e)
         p = positions[panels.indices[s]]
         diff = p - p.mean(axis=0) - panels.rest[s] @ rot[e].T
@@ -467,8 +471,10 @@ def _folded_frame(d: dict, source: str):
     return x, faces
 
 
-def _matching_mesh(pattern, thickness, hinge_width, subdivisions, positions, faces, source):
-    """The ThickMesh whose outer faces are ``faces`` (see :func:`read_result`)."""
+def _matching_mesh(pattern, thickness, hinge_width, subdivisions, positions, faces, source,
+                   elastic=None):
+    """The ThickMesh whose outer faces are ``faces`` (see :func:`read_result`);
+    ``elastic`` as stored in the file (``foldcore:faces_cells``)."""
     from .errors import MeshError
     from .mesh import surface_faces
     from .thickening import MAX_SUBDIVISIONS, thicken
@@ -482,7 +488,8 @@ def _matching_mesh(pattern, thickness, hinge_width, subdivisions, positions, fac
     first_error = None
     for k, exact in candidates:
         try:
-            mesh = thicken(pattern, thickness, hinge_width, k, exact_arc=exact)
+            mesh = thicken(pattern, thickness, hinge_width, k, exact_arc=exact,
+                           elastic=elastic or None)
         except MeshError as exc:
             first_error = first_error or exc
             continue
@@ -497,8 +504,8 @@ def _matching_mesh(pattern, thickness, hinge_width, subdivisions, positions, fac
     raise PatternError(f"{source}: the folded frame ({len(positions)} vertices, {len(faces)} "
                        f"faces) matches no thick mesh rebuilt from the file (thickness "
                        f"{thickness:g} mm, {tried}); pass the --subdivisions and "
-                       "--hinge-width used with simulate (meshes with elastic panels or "
-                       "stretch hinges cannot be rebuilt from a FOLD file yet)")
+                       "--hinge-width used with simulate (meshes with stretch hinges "
+                       "cannot be rebuilt from a FOLD file yet)")
 
 
 # ------------------------------------------------------------------- all at once

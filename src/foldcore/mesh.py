@@ -6,7 +6,7 @@ bottom layer (``z = -H/2``, ids ``M..2M-1``), where ``M`` is the number of
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -79,6 +79,10 @@ class ThickMesh:
         right: k·m strips, k in series across the crease, m side by side.
     panel_group : str
         Name of the group holding the panels.
+    elastic : dict {face: n or (n1, n2)}
+        The elastic faces as built (counts resolved: ``"auto"`` replaced),
+        so the same mesh can be rebuilt (stored in result FOLD files as
+        ``foldcore:faces_cells``); empty for rigid panels only.
     """
 
     points: np.ndarray
@@ -90,6 +94,7 @@ class ThickMesh:
     subdivisions: np.ndarray
     segments: np.ndarray | None = None
     panel_group: str = "rigid_panel"
+    elastic: dict = field(default_factory=dict)
 
     def __post_init__(self):
         if self.segments is None:

@@ -9,6 +9,7 @@ import platform
 
 import numpy as np
 
+from .io.fold import CELLS_KEY
 from .mesh import surface_faces
 
 
@@ -87,6 +88,17 @@ def write_report(path, report: dict) -> None:
         fh.write("\n")
 
 
+def _mesh_recipe(pattern, mesh) -> dict | None:
+    """FOLD keys that let a reader rebuild a mesh thicken() cannot guess: the elastic
+    faces' cell counts (``foldcore:faces_cells``, null for a rigid panel)."""
+    if not mesh.elastic:
+        return None
+    cells = [None] * len(pattern.faces)
+    for f, n in mesh.elastic.items():
+        cells[f] = list(n) if isinstance(n, tuple) else int(n)
+    return {CELLS_KEY: cells}
+
+
 def write_result(result, pattern, mesh, thickness: float, settings: dict, *, fold=None,
                  report=None, png=None, quantities: dict | None = None) -> None:
     """Write the outputs asked for: FOLD (achieved angles + folded solid), JSON report, PNG.
@@ -109,6 +121,7 @@ def write_result(result, pattern, mesh, thickness: float, settings: dict, *, fol
     if fold:
         from .io import write_fold
         write_fold(fold, pattern, achieved_angles=result.fold_angles_deg,
-                   frames=[folded_frame(mesh, result.positions)], thickness=thickness)
+                   frames=[folded_frame(mesh, result.positions)], thickness=thickness,
+                   extra=_mesh_recipe(pattern, mesh))
     if report:
         write_report(report, report_dict(result, pattern, mesh, settings, quantities))

@@ -330,10 +330,11 @@ def thicken(pattern: CreasePattern, thickness: float, hinge_width=None,
     if stretch:
         groups["stretch_hinge"] = _stretch_group(pattern, points, strip_points, stretch,
                                                  widths, thickness, stiff.get("hinge", 1.0))
+    built = {**{f: len(c) for f, c in cells.items() if f not in plates}, **plates}
     return ThickMesh(points=points, thickness=float(thickness), groups=groups,
                      panel_of_face=panel_of_face,
                      strips_of_crease=strips_of, hinge_width=widths, subdivisions=ks,
-                     segments=segments)
+                     segments=segments, elastic=built)
 
 
 def _prism(ids2d, points, thickness):

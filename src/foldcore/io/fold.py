@@ -25,6 +25,9 @@ foldcore's own keys (lengths in the file's ``frame_unit``; foldcore writes mm):
   ``edges_foldAngle`` (a simulation result); the target angles, degrees,
   valley positive, ``null`` = passive. When present it is read instead of
   ``edges_foldAngle``, so a result file reads back as the pattern simulated.
+* ``foldcore:faces_cells`` — in a result of a mesh with elastic panels: per
+  face ``null`` (rigid), a cell count (a bar) or two (a plate), as given to
+  ``thicken(elastic=...)``, so the mesh can be rebuilt.
 
 Every malformed input raises :class:`PatternError` naming the file and the
 offending item; files above :data:`MAX_FILE_BYTES` are refused unread.
@@ -59,6 +62,7 @@ THICKNESS_KEY = "foldcore:thickness"
 TARGET_KEY = "foldcore:edges_targetAngle"
 EDGE_STIFFNESS_KEY = "foldcore:edges_stiffness"
 FACE_STIFFNESS_KEY = "foldcore:faces_stiffness"
+CELLS_KEY = "foldcore:faces_cells"
 #: What a JSON array may be in a FOLD dict: a list, or a tuple from a Python caller.
 ARRAY = (list, tuple)
 
@@ -302,6 +306,25 @@ def _per_item(d: dict, key: str, n: int, item: str, source: str) -> list | None:
         if x is not None and value is None:
             _fail(source, f"{key}[{i}] ({item} {i}) must be a finite number or null, "
                           f"got {_short(x)}")
+    return out
+
+
+def faces_cells(d: dict, n_faces: int, source: str) -> dict:
+    """``{face: n or (n1, n2)}`` from ``foldcore:faces_cells`` ({} when absent)."""
+    raw = d.get(CELLS_KEY)
+    if raw is None:
+        return {}
+    _check_length(raw, CELLS_KEY, n_faces, source, "face")
+    out = {}
+    for f, x in enumerate(raw):
+        if x is None:
+            continue
+        counts = list(x) if isinstance(x, ARRAY) else [x]
+        if len(counts) not in (1, 2) or not all(
+                isinstance(c, int) and not isinstance(c, bool) and c >= 1 for c in counts):
+            _fail(source, f"{CELLS_KEY}[{f}] (face {f}) must be null, a cell count ≥ 1 or "
+                          f"two of them, got {_short(x)}")
+        out[f] = tuple(counts) if len(counts) == 2 else counts[0]
     return out
 
 
