@@ -28,6 +28,7 @@ import folded
 from folded import scene
 from foldcore import patterns
 from foldcore.cli import main
+from foldcore.errors import PatternError
 from foldcore.fabrication import (ExportError, atomic_path, read_result, sheet_outlines,
                                   stl_bytes, surface_triangles, triangulate_polygon)
 
@@ -235,6 +236,32 @@ def test_a_result_with_elastic_panels_reads_back_and_exports(tmp_path, capsys):
     err = capsys.readouterr().err
     assert "bad.fold" in err and "foldcore:faces_cells[1] (face 1)" in err
     assert not (tmp_path / "bad.stl").exists()
+
+
+def test_a_result_with_stretch_hinges_reads_back(tmp_path):
+    """foldcore:edges_poisson carries the stretch hinges: rebuilt and re-read (a stretch
+    strip's width is set by its ratio, so the file's faces alone could not say)."""
+    from foldcore.outputs import write_result
+    from foldcore.simulation import Simulation
+    from foldcore.thickening import thicken
+
+    pattern = patterns.single_hinge(panel_length=10.0, depth=10.0, width=2.0)
+    mesh = thicken(pattern, 1.0, stretch={0: 0.3}, stiffness={"panel": 0.1})
+    sim = Simulation(mesh, pattern)
+    sim.set_stretch_ratios({0: 1.2})
+    result = sim.run(tolerance=1e-9, max_iterations=2_000)
+    path = tmp_path / "stretch.fold"
+    write_result(result, pattern, mesh, 1.0, {}, fold=path)
+    back = read_result(path)
+    assert list(back.mesh.groups) == list(mesh.groups)
+    assert back.mesh.groups["stretch_hinge"].params[0, 3] == pytest.approx(0.3)
+    assert back.positions == pytest.approx(result.positions, abs=1e-12)
+    edited = json.loads(path.read_text())
+    edited["foldcore:edges_poisson"][0] = 0.7
+    bad = tmp_path / "bad.fold"
+    bad.write_text(json.dumps(edited))
+    with pytest.raises(PatternError, match=r"foldcore:edges_poisson\[0\] \(edge 0\)"):
+        read_result(bad)
 
 
 def _bad_export_inputs(result_fold, tmp_path):

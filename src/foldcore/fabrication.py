@@ -417,7 +417,8 @@ def read_result(path, hinge_width=None, subdivisions=None) -> ResultFile:
         Unreadable or malformed file, no folded frame, no thickness, or no
         rebuilt mesh matching the stored faces.
     """
-    from .io.fold import _parse_json, faces_cells, fold_file_from_dict, read_bytes
+    from .io.fold import (_parse_json, edges_poisson, faces_cells, fold_file_from_dict,
+                          read_bytes)
     from .measure import element_rotations
 
     source = os.fspath(path)
@@ -426,9 +427,10 @@ def read_result(path, hinge_width=None, subdivisions=None) -> ResultFile:
     positions, faces = _folded_frame(d, source)
     if fold.thickness is None:
         raise PatternError(f"{source}: no foldcore:thickness; not a foldcore result file")
-    elastic = faces_cells(d, len(fold.pattern.faces), source)
+    recipe = {"elastic": faces_cells(d, len(fold.pattern.faces), source) or None,
+              "stretch": edges_poisson(d, fold.pattern.n_edges, source) or None}
     mesh = _matching_mesh(fold.pattern, fold.thickness, hinge_width, subdivisions,
-                          positions, faces, source, elastic)
+                          positions, faces, source, recipe)
     panels = mesh.groups[mesh.panel_group]
     rot = element_rotations(panels, positions)
     misfit = 0.0
@@ -472,9 +474,9 @@ def _folded_frame(d: dict, source: str):
 
 
 def _matching_mesh(pattern, thickness, hinge_width, subdivisions, positions, faces, source,
-                   elastic=None):
+                   recipe=None):
     """The ThickMesh whose outer faces are ``faces`` (see :func:`read_result`);
-    ``elastic`` as stored in the file (``foldcore:faces_cells``)."""
+    ``recipe``: thicken's ``elastic``/``stretch`` as stored in the file."""
     from .errors import MeshError
     from .mesh import surface_faces
     from .thickening import MAX_SUBDIVISIONS, thicken
@@ -489,7 +491,7 @@ def _matching_mesh(pattern, thickness, hinge_width, subdivisions, positions, fac
     for k, exact in candidates:
         try:
             mesh = thicken(pattern, thickness, hinge_width, k, exact_arc=exact,
-                           elastic=elastic or None)
+                           **(recipe or {}))
         except MeshError as exc:
             first_error = first_error or exc
             continue
@@ -504,8 +506,7 @@ def _matching_mesh(pattern, thickness, hinge_width, subdivisions, positions, fac
     raise PatternError(f"{source}: the folded frame ({len(positions)} vertices, {len(faces)} "
                        f"faces) matches no thick mesh rebuilt from the file (thickness "
                        f"{thickness:g} mm, {tried}); pass the --subdivisions and "
-                       "--hinge-width used with simulate (meshes with stretch hinges "
-                       "cannot be rebuilt from a FOLD file yet)")
+                       "--hinge-width used with simulate")
 
 
 # ------------------------------------------------------------------- all at once

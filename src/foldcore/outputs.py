@@ -9,7 +9,7 @@ import platform
 
 import numpy as np
 
-from .io.fold import CELLS_KEY
+from .io.fold import CELLS_KEY, POISSON_KEY
 from .mesh import surface_faces
 
 
@@ -90,13 +90,23 @@ def write_report(path, report: dict) -> None:
 
 def _mesh_recipe(pattern, mesh) -> dict | None:
     """FOLD keys that let a reader rebuild a mesh thicken() cannot guess: the elastic
-    faces' cell counts (``foldcore:faces_cells``, null for a rigid panel)."""
-    if not mesh.elastic:
-        return None
-    cells = [None] * len(pattern.faces)
-    for f, n in mesh.elastic.items():
-        cells[f] = list(n) if isinstance(n, tuple) else int(n)
-    return {CELLS_KEY: cells}
+    faces' cell counts (``foldcore:faces_cells``, null for a rigid panel) and the
+    stretch hinges' Poisson ratios (``foldcore:edges_poisson``, null elsewhere)."""
+    from elements.stretch_hinge import STRETCH_PARAMS
+
+    recipe = {}
+    if mesh.elastic:
+        cells = [None] * len(pattern.faces)
+        for f, n in mesh.elastic.items():
+            cells[f] = list(n) if isinstance(n, tuple) else int(n)
+        recipe[CELLS_KEY] = cells
+    stretch = mesh.groups.get("stretch_hinge")
+    if stretch is not None and len(stretch):
+        nu = [None] * pattern.n_edges
+        for e, row in zip(stretch.source, stretch.params):
+            nu[int(e)] = float(row[STRETCH_PARAMS.index("poisson")])
+        recipe[POISSON_KEY] = nu
+    return recipe or None
 
 
 def write_result(result, pattern, mesh, thickness: float, settings: dict, *, fold=None,

@@ -28,6 +28,9 @@ foldcore's own keys (lengths in the file's ``frame_unit``; foldcore writes mm):
 * ``foldcore:faces_cells`` — in a result of a mesh with elastic panels: per
   face ``null`` (rigid), a cell count (a bar) or two (a plate), as given to
   ``thicken(elastic=...)``, so the mesh can be rebuilt.
+* ``foldcore:edges_poisson`` — in a result of a mesh with stretch hinges: per
+  edge ``null`` (a bending hinge or boundary) or the stretch hinge's Poisson
+  ratio ν, as given to ``thicken(stretch=...)``.
 
 Every malformed input raises :class:`PatternError` naming the file and the
 offending item; files above :data:`MAX_FILE_BYTES` are refused unread.
@@ -63,6 +66,7 @@ TARGET_KEY = "foldcore:edges_targetAngle"
 EDGE_STIFFNESS_KEY = "foldcore:edges_stiffness"
 FACE_STIFFNESS_KEY = "foldcore:faces_stiffness"
 CELLS_KEY = "foldcore:faces_cells"
+POISSON_KEY = "foldcore:edges_poisson"
 #: What a JSON array may be in a FOLD dict: a list, or a tuple from a Python caller.
 ARRAY = (list, tuple)
 
@@ -325,6 +329,21 @@ def faces_cells(d: dict, n_faces: int, source: str) -> dict:
             _fail(source, f"{CELLS_KEY}[{f}] (face {f}) must be null, a cell count ≥ 1 or "
                           f"two of them, got {_short(x)}")
         out[f] = tuple(counts) if len(counts) == 2 else counts[0]
+    return out
+
+
+def edges_poisson(d: dict, n_edges: int, source: str) -> dict:
+    """``{edge: ν}`` of the stretch hinges from ``foldcore:edges_poisson`` ({} when
+    absent); ν in [−1, 0.5]."""
+    values = _per_edge(d, POISSON_KEY, n_edges, source)
+    out = {}
+    for e, nu in enumerate(values or []):
+        if nu is None:
+            continue
+        if not -1.0 <= nu <= 0.5:
+            _fail(source, f"{POISSON_KEY}[{e}] (edge {e}) must be a Poisson ratio in "
+                          f"[-1, 0.5] or null, got {_short(nu)}")
+        out[e] = float(nu)
     return out
 
 
