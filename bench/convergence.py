@@ -78,9 +78,7 @@ def miura_scene(n: int, thickness: float):
     actuated to 60° (facet tilt θ = 30°), all others passive."""
     pattern = patterns.miura(n, n, a=20.0, b=20.0, gamma=60.0, width=2.0 * thickness)
     kinds = patterns.miura_edge_kinds(n, n)
-    zigzag, straight = kinematics.miura_angles_deg(60.0, 30.0)
-    sign = np.select([pattern.assignments == "V", pattern.assignments == "M"], [1.0, -1.0], 0.0)
-    expected = sign * np.where(kinds == "zigzag", zigzag, straight)
+    expected = patterns.miura_fold_angles(n, n, 60.0, 30.0)
     creases = np.flatnonzero(kinds != "boundary")
     zz = np.flatnonzero(kinds == "zigzag")
     actuated = int(zz[len(zz) // 2])

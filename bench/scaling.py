@@ -96,16 +96,12 @@ def peak_rss_mb() -> float:
 # ------------------------------------------------------------------ child
 def miura_actuated(n: int):
     """(pattern generation seconds, actuation seconds, actuated pattern)."""
-    from foldcore import kinematics, patterns
+    from foldcore import patterns
 
     t0 = time.perf_counter()
     pattern = patterns.miura(n, n, a=EDGE, b=EDGE, gamma=GAMMA)
     t1 = time.perf_counter()
-    zigzag, straight = kinematics.miura_angles_deg(GAMMA, TILT)
-    kinds = patterns.miura_edge_kinds(n, n)
-    magnitude = np.select([kinds == "zigzag", kinds == "straight"], [zigzag, straight], np.nan)
-    sign = np.where(pattern.assignments == "M", -1.0, 1.0)
-    pattern = pattern.replace(fold_angles=np.where(kinds == "boundary", np.nan, sign * magnitude))
+    pattern = pattern.replace(fold_angles=patterns.miura_fold_angles(n, n, GAMMA, TILT))
     return t1 - t0, time.perf_counter() - t1, pattern
 
 

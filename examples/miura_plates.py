@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from foldcore import kinematics, patterns
+from foldcore import patterns
 from foldcore.outputs import write_result
 from foldcore.simulation import Simulation
 from foldcore.thickening import thicken
@@ -25,12 +25,8 @@ THICKNESS, WIDTH, CELL = 1.0, 2.0, 5.0  # mm
 
 
 def actuated_miura():
-    pattern = patterns.miura(N, N, a=A, b=A, gamma=GAMMA, width=WIDTH)
-    kinds = patterns.miura_edge_kinds(N, N)
-    zigzag, straight = kinematics.miura_angles_deg(GAMMA, TILT)
-    sign = np.select([pattern.assignments == "V", pattern.assignments == "M"], [1.0, -1.0], 0.0)
-    return pattern.replace(fold_angles=sign * np.select(
-        [kinds == "zigzag", kinds == "straight"], [zigzag, straight], np.nan))
+    return patterns.miura(N, N, a=A, b=A, gamma=GAMMA, width=WIDTH).replace(
+        fold_angles=patterns.miura_fold_angles(N, N, GAMMA, TILT))
 
 
 def main(out="out") -> dict:

@@ -150,6 +150,19 @@ def test_miura_vertices_close_at_theta_30(gamma):
     assert max(k.vertex_closure_residuals(cp, flipped).values()) > 1e-2
 
 
+@pytest.mark.parametrize("gamma, tilt", [(60.0, 30.0), (45.0, 50.0)])
+def test_miura_fold_angles_are_the_signed_closing_rigid_fold_angles(gamma, tilt):
+    """miura_fold_angles = the closed-form magnitudes signed by the pattern's own M/V:
+    every interior vertex closes (1e-9 rad, rounding), NaN on the boundary."""
+    cp = p.miura(4, 3, a=20.0, b=12.0, gamma=gamma)
+    rho = p.miura_fold_angles(4, 3, gamma, tilt)
+    boundary = cp.assignments == "B"
+    assert np.isnan(rho[boundary]).all() and np.isfinite(rho[~boundary]).all()
+    assert (np.sign(rho[~boundary]) == _signs(cp)[~boundary]).all()
+    residuals = k.vertex_closure_residuals(cp, np.radians(np.nan_to_num(rho)))
+    assert max(residuals.values()) < 1e-9
+
+
 def test_miura_assignment_pattern():
     cp = p.miura(4, 4)
     kinds = p.miura_edge_kinds(4, 4)

@@ -16,8 +16,8 @@ from . import kinematics
 from .errors import PatternError
 from .pattern import CreasePattern
 
-__all__ = ["degree4_vertex", "waterbomb", "miura", "miura_edge_kinds", "single_hinge",
-           "grid", "degree4_assignments"]
+__all__ = ["degree4_vertex", "waterbomb", "miura", "miura_edge_kinds", "miura_fold_angles",
+           "single_hinge", "grid", "degree4_assignments"]
 
 PEHRSON_SECTORS = (135.0, 90.0, 45.0, 90.0)
 PEHRSON_WIDTHS = (16.0, 4.0, 8.0, 4.0)
@@ -252,6 +252,25 @@ def miura_edge_kinds(n: int, m: int) -> np.ndarray:
     straight = np.where((row > 0) & (row < m), "straight", "boundary")
     zigzag = np.where((col > 0) & (col < n), "zigzag", "boundary")
     return np.concatenate([straight, zigzag]).astype("<U8")
+
+
+def miura_fold_angles(n: int, m: int, gamma: float, tilt: float) -> np.ndarray:
+    """(E,) zero-thickness rigid-fold angle of every edge of :func:`miura` ``(n, m)``
+    at facet tilt θ (degrees, signed by its M/V: valley positive; NaN on the
+    boundary): zig-zag |ρ| = 2θ, straight tan(|ρ|/2) = cos γ tan θ
+    (:func:`foldcore.kinematics.miura_angles_deg`).
+
+    Parameters
+    ----------
+    n, m : int
+        Facets along x and y.
+    gamma, tilt : float, degrees
+        Acute facet angle γ and facet tilt θ.
+    """
+    kinds = miura_edge_kinds(n, m)
+    zigzag, straight = kinematics.miura_angles_deg(gamma, tilt)
+    sign = np.where(np.array(_miura_assignments(n, m)) == "M", -1.0, 1.0)
+    return sign * np.select([kinds == "zigzag", kinds == "straight"], [zigzag, straight], np.nan)
 
 
 def _miura_assignments(n: int, m: int) -> list[str]:

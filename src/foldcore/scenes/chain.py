@@ -49,8 +49,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..kinematics import miura_angles_deg, miura_cell
-from ..patterns import miura, miura_edge_kinds
+from ..kinematics import miura_cell
+from ..patterns import miura, miura_edge_kinds, miura_fold_angles
 from ..simulation import Simulation
 from ..thickening import thicken
 from . import SceneRun
@@ -107,13 +107,8 @@ def headline(quantities: dict) -> str:
 
 def _deployed_pattern():
     """The strip with every crease's target at its rigid-fold angle (degrees, signed)."""
-    pattern = miura(N, M, a=A, b=B, gamma=GAMMA, width=WIDTH)
-    kinds = miura_edge_kinds(N, M)
-    zigzag, straight = miura_angles_deg(GAMMA, TILT)
-    sign = np.select([pattern.assignments == "V", pattern.assignments == "M"], [1.0, -1.0], 0.0)
-    expected = sign * np.select([kinds == "zigzag", kinds == "straight"], [zigzag, straight],
-                                np.nan)
-    return pattern.replace(fold_angles=expected), expected
+    expected = miura_fold_angles(N, M, GAMMA, TILT)
+    return miura(N, M, a=A, b=B, gamma=GAMMA, width=WIDTH).replace(fold_angles=expected), expected
 
 
 def _panel_vertices(mesh, face: int) -> np.ndarray:

@@ -24,7 +24,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..kinematics import miura_angles_deg, miura_cell
-from ..patterns import miura, miura_edge_kinds
+from ..patterns import miura, miura_edge_kinds, miura_fold_angles
 from ..simulation import Simulation
 from ..thickening import thicken
 from . import SceneRun
@@ -40,13 +40,10 @@ def run(quick: bool = False, solver: str | None = None) -> SceneRun:
     """Fold the sheet to tilt θ with every crease actuated (see module docstring)."""
     solver = solver or "rigid"
     budget = (100 if quick else 400) if solver == "rigid" else (2_000 if quick else 40_000)
-    pattern = miura(N, M, a=A, b=B, gamma=GAMMA, width=WIDTH)
+    expected = miura_fold_angles(N, M, GAMMA, TILT)
+    pattern = miura(N, M, a=A, b=B, gamma=GAMMA, width=WIDTH).replace(fold_angles=expected)
     kinds = miura_edge_kinds(N, M)
     zigzag, straight = miura_angles_deg(GAMMA, TILT)
-    sign = np.select([pattern.assignments == "V", pattern.assignments == "M"], [1.0, -1.0], 0.0)
-    expected = sign * np.select([kinds == "zigzag", kinds == "straight"], [zigzag, straight],
-                                np.nan)
-    pattern = pattern.replace(fold_angles=expected)
     mesh = thicken(pattern, THICKNESS, subdivisions=SUBDIVISIONS)
     result = Simulation(mesh, pattern, solver=solver).run(tolerance=TOLERANCE,
                                                          max_iterations=budget)
