@@ -408,63 +408,57 @@ class Simulation:
             Called after each iteration; returning False stops the run.
         """
         start = time.perf_counter()
-        converged = False
         self.timings.setdefault("total", self.timings["setup"])
-        budget = int(max_iterations)
+        budget, limit = int(max_iterations), tolerance * self.length_scale
+        moved, stopped = np.inf, False
         if self._rigid_phase and budget > 0:
-            budget, stopped, converged = self._hybrid_rigid_phase(tolerance, budget, callback)
-            if stopped:
-                budget = 0
-            converged = converged and budget == 0
-        for _ in range(budget):
+            used, moved, stopped = self._hybrid_rigid_phase(tolerance, budget, callback)
+            budget -= used
+        if budget > 0 and not stopped:
+            _, moved, stopped = self._iterate(budget, callback, limit)
+        self.timings["total"] += time.perf_counter() - start
+        self.timings["bare_solve"] = self._bare_solve_floor()
+        return self.result(not stopped and moved <= limit)
+
+    def _iterate(self, budget: int, callback, stop_at: float) -> tuple[int, float, bool]:
+        """Up to ``budget`` steps, until one moves ≤ ``stop_at`` mm or the callback says
+        stop; returns (steps taken, the last step's move in mm, whether the callback
+        stopped)."""
+        moved = np.inf
+        for used in range(1, budget + 1):
             moved = self.step()
             if not np.isfinite(moved):
                 raise SimulationError("the iteration produced non-finite positions")
             if callback is not None and callback(self, moved) is False:
-                break
-            if moved <= tolerance * self.length_scale:
-                converged = True
-                break
-        self.timings["total"] += time.perf_counter() - start
-        self.timings["bare_solve"] = self._bare_solve_floor()
-        return self.result(converged)
+                return used, moved, True
+            if moved <= stop_at:
+                return used, moved, False
+        return budget, moved, False
 
     def _hybrid_rigid_phase(self, tolerance: float, budget: int,
-                            callback) -> tuple[int, bool, bool]:
+                            callback) -> tuple[int, float, bool]:
         """``solver="hybrid"``: rigid-body Levenberg–Marquardt steps from the current
         positions until they stop moving (≤ max(tolerance, HYBRID_RIGID_TOL) × size)
         or HYBRID_RIGID_MAX steps, then L-BFGS continues from there on the paper's
-        energy. Returns (iterations left, whether the callback stopped the run,
-        whether the last step met ``tolerance``). Meshes the rigid strategy cannot
-        take (elastic cells, other element types) go straight to L-BFGS. Whatever
-        ends the phase (an exception, an interrupt included), the simulation is
-        left in its L-BFGS phase."""
+        energy. Returns :meth:`_iterate`'s (steps, last move, stopped). Meshes the
+        rigid strategy cannot take (elastic cells, other element types) go straight
+        to L-BFGS. Whatever ends the phase (an exception, an interrupt included),
+        the simulation is left in its L-BFGS phase."""
         from .rigid_body import RigidBodySolver
 
         self._rigid_phase = False
         try:
             self._rigid = RigidBodySolver(self)
         except SimulationError:
-            return budget, False, False
-        stop_at = max(tolerance, HYBRID_RIGID_TOL) * self.length_scale
-        used, stopped, moved = 0, False, np.inf
+            return 0, np.inf, False
         try:
             self.x = self._rigid.x
-            while used < min(budget, HYBRID_RIGID_MAX):
-                moved = self.step()
-                used += 1
-                if not np.isfinite(moved):
-                    raise SimulationError("the iteration produced non-finite positions")
-                if callback is not None and callback(self, moved) is False:
-                    stopped = True
-                    break
-                if moved <= stop_at:
-                    break
+            return self._iterate(min(budget, HYBRID_RIGID_MAX), callback,
+                                 max(tolerance, HYBRID_RIGID_TOL) * self.length_scale)
         finally:
             self._rigid = None
             self.x = np.ascontiguousarray(self.x.copy())
             self._accelerated.restart(self.x)
-        return budget - used, stopped, moved <= tolerance * self.length_scale
 
     def _bare_solve_floor(self) -> float:
         """:meth:`bare_solve_seconds`, timed once per factorisation of K (a sweep of
