@@ -367,15 +367,9 @@ def _elastic_cells(pattern, loops, elastic, table, cell_size) -> dict:
         side = _single_crease_side(pattern, f, len(loop))
         a, b, c, d = (loop[(side + k) % 4] for k in range(4))
         pa, pb, pc, pd = (table.coords[i] for i in (a, b, c, d))
-        if isinstance(n, str) and n == "auto":
-            if not (cell_size is not None and np.isfinite(cell_size) and cell_size > 0):
-                raise MeshError(f"{pattern.source}: elastic panel on face {f}: 'auto' needs "
-                                f"a positive cell_size in mm, got {cell_size!r}")
-            length = 0.5 * (np.linalg.norm(pd - pa) + np.linalg.norm(pc - pb))
-            n = max(1, int(np.ceil(length / cell_size - 1e-9)))
-        if isinstance(n, str) or int(n) != n or n < 1:
-            raise MeshError(f"{pattern.source}: elastic panel on face {f}: the number of "
-                            f"cells must be a positive integer or 'auto', got {n!r}")
+        length = 0.5 * (np.linalg.norm(pd - pa) + np.linalg.norm(pc - pb))
+        n = _cell_count(n, length, cell_size, f"{pattern.source}: elastic panel on face {f}",
+                        f"the number of cells must be a positive integer or 'auto', got {n!r}")
         inner_a = [table.add(pa + t * (pd - pa)) for t in np.arange(1, n) / n]
         inner_b = [table.add(pb + t * (pc - pb)) for t in np.arange(1, n) / n]
         side_a, side_b = [a] + inner_a + [d], [b] + inner_b + [c]
@@ -419,19 +413,25 @@ def _plate_counts(pattern, plates, corners, cell_size) -> dict:
                             "sides")
         c = np.asarray(corners[f])
         side = np.linalg.norm(np.roll(c, -1, axis=0) - c, axis=1)
-        resolved = []
-        for n, length in zip(counts, (max(side[0], side[2]), max(side[1], side[3]))):
-            if isinstance(n, str) and n == "auto":
-                if not (cell_size is not None and np.isfinite(cell_size) and cell_size > 0):
-                    raise MeshError(f"{pattern.source}: elastic plate on face {f}: 'auto' "
-                                    f"needs a positive cell_size in mm, got {cell_size!r}")
-                n = max(1, int(np.ceil(length / cell_size - 1e-9)))
-            if isinstance(n, str) or int(n) != n or n < 1:
-                raise MeshError(f"{pattern.source}: elastic plate on face {f}: cell counts "
-                                f"must be positive integers or 'auto', got {counts!r}")
-            resolved.append(int(n))
-        out[f] = tuple(resolved)
+        where = f"{pattern.source}: elastic plate on face {f}"
+        out[f] = tuple(
+            _cell_count(n, length, cell_size, where,
+                        f"cell counts must be positive integers or 'auto', got {counts!r}")
+            for n, length in zip(counts, (max(side[0], side[2]), max(side[1], side[3]))))
     return out
+
+
+def _cell_count(n, length: float, cell_size, where: str, bad: str) -> int:
+    """A cell count: ``n`` checked, or for ``"auto"`` ⌈length / cell_size⌉ (mm / mm);
+    ``where`` and ``bad`` make the refusal's message."""
+    if isinstance(n, str) and n == "auto":
+        if not (cell_size is not None and np.isfinite(cell_size) and cell_size > 0):
+            raise MeshError(f"{where}: 'auto' needs a positive cell_size in mm, "
+                            f"got {cell_size!r}")
+        n = max(1, int(np.ceil(length / cell_size - 1e-9)))
+    if isinstance(n, str) or int(n) != n or n < 1:
+        raise MeshError(f"{where}: {bad}")
+    return int(n)
 
 
 def _segments(pattern, plates, stretch, bars) -> np.ndarray:
