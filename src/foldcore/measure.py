@@ -46,7 +46,13 @@ def fold_angles(pattern, mesh, positions: np.ndarray) -> np.ndarray:
     d2 = pattern.vertices[pattern.edges[crease, 1]] - pattern.vertices[pattern.edges[crease, 0]]
     d_rest = np.column_stack([d2, np.zeros(len(crease))])
     d = np.einsum("nij,nj->ni", left + right, d_rest)
-    n_left, n_right = left[:, :, 2], right[:, :, 2]
-    sin = np.einsum("ni,ni->n", np.cross(n_right, n_left), d / np.linalg.norm(d, axis=1)[:, None])
-    out[crease] = np.degrees(np.arctan2(sin, np.einsum("ni,ni->n", n_left, n_right)))
+    out[crease] = dihedral_deg(left[:, :, 2], right[:, :, 2], d)
     return out
+
+
+def dihedral_deg(n_left: np.ndarray, n_right: np.ndarray, d: np.ndarray) -> np.ndarray:
+    """(n,) fold angles, degrees, valley positive: ρ = atan2((n_R × n_L)·d̂, n_L·n_R)
+    for unit face normals n_L, n_R (n, 3) left and right of creases along d (n, 3)."""
+    d_hat = d / np.linalg.norm(d, axis=1)[:, None]
+    sin = np.einsum("ni,ni->n", np.cross(n_right, n_left), d_hat)
+    return np.degrees(np.arctan2(sin, np.einsum("ni,ni->n", n_left, n_right)))

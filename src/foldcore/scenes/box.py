@@ -83,6 +83,7 @@ import time
 import numpy as np
 
 from ..fabrication import enclosed_volume, sheet_outlines, surface_triangles
+from ..measure import dihedral_deg
 from ..pattern import CreasePattern
 from ..simulation import Simulation
 from ..strain import estimated_strip_angles
@@ -256,7 +257,7 @@ def thin_fold_angles(pattern: CreasePattern, positions: np.ndarray) -> np.ndarra
 
     Same convention as :func:`foldcore.measure.fold_angles`: with the face
     normals n_L, n_R (Newell, the pattern's CCW loops) and the crease
-    direction d, ρ = atan2((n_R × n_L)·d, n_L·n_R).
+    direction d, ρ = atan2((n_R × n_L)·d, n_L·n_R) (:func:`foldcore.measure.dihedral_deg`).
     """
     normals = np.array([_newell(positions[f]) for f in pattern.faces])
     out = np.full(pattern.n_edges, np.nan)
@@ -264,9 +265,7 @@ def thin_fold_angles(pattern: CreasePattern, positions: np.ndarray) -> np.ndarra
     n_left = normals[pattern.edge_faces[crease, 0]]
     n_right = normals[pattern.edge_faces[crease, 1]]
     d = positions[pattern.edges[crease, 1]] - positions[pattern.edges[crease, 0]]
-    d /= np.linalg.norm(d, axis=1)[:, None]
-    sin = np.einsum("ni,ni->n", np.cross(n_right, n_left), d)
-    out[crease] = np.degrees(np.arctan2(sin, np.einsum("ni,ni->n", n_left, n_right)))
+    out[crease] = dihedral_deg(n_left, n_right, d)
     return out
 
 
