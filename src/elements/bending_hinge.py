@@ -31,7 +31,6 @@ targets are fixed points of their own estimate. The angle used is written to
 """
 import math
 
-import numpy as np
 from numba import njit, prange
 
 from ._registry import ElementType

@@ -89,7 +89,7 @@ def run(quick: bool = False, solver: str | None = None) -> SceneRun:
         rows.append(_row(push, result, mesh, kinds, start + push * across, pushed, done))
         done = int(result.iterations)
     quantities = {"deployed": _deployed_quantities(deployed, pattern, expected, kinds),
-                  "before": _lengths(mesh, rows[0]), "after": _lengths(mesh, rows[-1]),
+                  "before": _lengths(rows[0]), "after": _lengths(rows[-1]),
                   "rigid_fold_lengths_mm": _rigid_fold_lengths(), "pushes": rows}
     settings = {"solver": solver, "tolerance": TOLERANCE, "max_iterations": budget,
                 "thickness_mm": THICKNESS, "hinge_width_mm": round(WIDTH, 4),
@@ -150,7 +150,7 @@ def _row(push, result, mesh, kinds, target, pushed, done) -> dict:
             "converged": bool(result.converged)}
 
 
-def _lengths(mesh, row: dict) -> dict:
+def _lengths(row: dict) -> dict:
     return {k: row[k] for k in ("push_mm", "transverse_mm", "longitudinal_mm")}
 
 

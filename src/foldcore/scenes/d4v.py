@@ -14,8 +14,6 @@ normal of the panel left of crease 1; n stacked layers of H give ≥ n·H).
 """
 from __future__ import annotations
 
-import numpy as np
-
 from ..kinematics import degree4_deg
 from ..patterns import PEHRSON_SECTORS, degree4_vertex
 from ..simulation import Simulation

@@ -22,8 +22,6 @@ the minor magnitude for the actuated major one).
 """
 from __future__ import annotations
 
-import numpy as np
-
 from ..kinematics import waterbomb_minor_deg
 from ..patterns import waterbomb
 from ..simulation import Simulation
