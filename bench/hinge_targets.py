@@ -13,7 +13,6 @@ import statistics
 import time
 from pathlib import Path
 
-
 from foldcore import patterns, thicken
 from foldcore.simulation import Simulation
 
