@@ -146,6 +146,11 @@ class _PointTable:
         self.coords.append(np.asarray(xy, dtype=float))
         return len(self.coords) - 1
 
+    def between(self, a: int, b: int, fractions) -> list[int]:
+        """Ids [a, new points at the given fractions of the way a → b, b]."""
+        p, q = self.coords[a], self.coords[b]
+        return [a] + [self.add(p + t * (q - p)) for t in fractions] + [b]
+
 
 def _corner_ids(pattern, widths, table):
     offsets = _face_offsets(pattern, widths)
@@ -370,9 +375,8 @@ def _elastic_cells(pattern, loops, elastic, table, cell_size) -> dict:
         length = 0.5 * (np.linalg.norm(pd - pa) + np.linalg.norm(pc - pb))
         n = _cell_count(n, length, cell_size, f"{pattern.source}: elastic panel on face {f}",
                         f"the number of cells must be a positive integer or 'auto', got {n!r}")
-        inner_a = [table.add(pa + t * (pd - pa)) for t in np.arange(1, n) / n]
-        inner_b = [table.add(pb + t * (pc - pb)) for t in np.arange(1, n) / n]
-        side_a, side_b = [a] + inner_a + [d], [b] + inner_b + [c]
+        side_a = table.between(a, d, np.arange(1, n) / n)
+        side_b = table.between(b, c, np.arange(1, n) / n)
         cells[f] = [[side_a[j], side_b[j], side_b[j + 1], side_a[j + 1]] for j in range(int(n))]
     return cells
 
@@ -522,9 +526,7 @@ def _plate_sides(pattern, f, loop, corners, table, strip_pieces, counts) -> list
     for s in range(4):  # two opposite sides without strip points: equal pieces
         n = counts[s % 2]
         if bare[s] and bare[(s + 2) % 4] and n > 1:
-            p, q = table.coords[sides[s][0]], table.coords[sides[s][1]]
-            sides[s] = [sides[s][0]] + [table.add(p + t * (q - p))
-                                        for t in np.arange(1, n) / n] + [sides[s][1]]
+            sides[s] = table.between(sides[s][0], sides[s][1], np.arange(1, n) / n)
     for s in (0, 1):
         sides[s], sides[s + 2] = _equal_counts(pattern, f, s, sides[s], sides[s + 2], table,
                                                strip_pieces)
@@ -559,13 +561,10 @@ def _equal_counts(pattern, f, s, near, far, table, strip_pieces) -> tuple[list, 
 def _refined(side, other, has_strip, table, strip_pieces):
     """``side`` with one more point: at the other side's next relative position if it
     has no strip, else splitting its longest end gap; None if it cannot."""
-    pts = np.array([table.coords[i] for i in side])
     if not has_strip:
-        q = np.array([table.coords[i] for i in other])
-        t = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(q, axis=0), axis=1))]
-        t /= t[-1]
-        p0, p1 = pts[0], pts[-1]
-        return [side[0]] + [table.add(p0 + u * (p1 - p0)) for u in t[1:-1]] + [side[-1]]
+        return table.between(side[0], side[-1],
+                             _chord_params(np.array([table.coords[i] for i in other]))[1:-1])
+    pts = np.array([table.coords[i] for i in side])
     ends = [(float(np.linalg.norm(pts[1] - pts[0])), 0),
             (float(np.linalg.norm(pts[-1] - pts[-2])), len(side) - 2)]
     ends = [(length, k) for length, k in ends if len(side) > 2 and length > 0]
@@ -578,6 +577,12 @@ def _refined(side, other, has_strip, table, strip_pieces):
     return side[:k + 1] + [middle] + side[k + 1:]
 
 
+def _chord_params(points: np.ndarray) -> np.ndarray:
+    """(n,) chord-length parameters 0 … 1 of a polyline's points (n, 2)."""
+    t = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))]
+    return t / t[-1]
+
+
 def _coons_grid(sides, table) -> np.ndarray:
     """(n1 + 1, n2 + 1) point ids: the four sides on the border, interior points by a
     Coons patch of the sides over their chord-length parameters."""
@@ -586,13 +591,8 @@ def _coons_grid(sides, table) -> np.ndarray:
     b2 = np.array([table.coords[i] for i in sides[2][::-1]])
     b3 = np.array([table.coords[i] for i in sides[3][::-1]])
     n1, n2 = len(b0) - 1, len(b1) - 1
-
-    def params(points):
-        t = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))]
-        return t / t[-1]
-
-    u = 0.5 * (params(b0) + params(b2))
-    v = 0.5 * (params(b3) + params(b1))
+    u = 0.5 * (_chord_params(b0) + _chord_params(b2))
+    v = 0.5 * (_chord_params(b3) + _chord_params(b1))
     c0, c1, c2, c3 = b0[0], b0[-1], b2[-1], b2[0]
     grid = np.empty((n1 + 1, n2 + 1), dtype=np.int64)
     grid[:, 0], grid[n1, :] = sides[0], sides[1]
