@@ -16,6 +16,7 @@ from .errors import SimulationError
 from .measure import fold_angles
 from .strategies import DEFAULT_SOLVER, SOLVERS
 from .system import System
+from .threads import blas_on_one_thread
 
 ALPHA_UPDATE_EVERY = 10  # iterations between α-schedule updates (each costs a refactor)
 STOP_ENTER = 1e-3  # rad past its bound before a passive strip becomes a stop
@@ -325,7 +326,15 @@ class Simulation:
 
     # ------------------------------------------------------------- iteration
     def step(self) -> float:
-        """One iteration of the strategy; returns the largest vertex displacement (mm)."""
+        """One iteration of the strategy; returns the largest vertex displacement (mm).
+
+        With more than one numba thread, BLAS runs on one thread meanwhile
+        (:mod:`foldcore.threads`).
+        """
+        with blas_on_one_thread(self.threads > 1):
+            return self._step()
+
+    def _step(self) -> float:
         numba.set_num_threads(self.threads)
         if self._rigid is not None:
             energy, moved = self._rigid_iteration()
@@ -405,17 +414,20 @@ class Simulation:
             extent in mm is the scale).
         max_iterations : int
         callback : callable(sim, moved_mm) -> bool or None, optional
-            Called after each iteration; returning False stops the run.
+            Called after each iteration; returning False stops the run. It runs
+            with BLAS on one thread when the simulation uses several numba
+            threads (:mod:`foldcore.threads`).
         """
         start = time.perf_counter()
         self.timings.setdefault("total", self.timings["setup"])
         budget, limit = int(max_iterations), tolerance * self.length_scale
         moved, stopped = np.inf, False
-        if self._rigid_phase and budget > 0:
-            used, moved, stopped = self._hybrid_rigid_phase(tolerance, budget, callback)
-            budget -= used
-        if budget > 0 and not stopped:
-            _, moved, stopped = self._iterate(budget, callback, limit)
+        with blas_on_one_thread(self.threads > 1, refresh=True):
+            if self._rigid_phase and budget > 0:
+                used, moved, stopped = self._hybrid_rigid_phase(tolerance, budget, callback)
+                budget -= used
+            if budget > 0 and not stopped:
+                _, moved, stopped = self._iterate(budget, callback, limit)
         self.timings["total"] += time.perf_counter() - start
         self.timings["bare_solve"] = self._bare_solve_floor()
         return self.result(not stopped and moved <= limit)
@@ -426,7 +438,7 @@ class Simulation:
         stopped)."""
         moved = np.inf
         for used in range(1, budget + 1):
-            moved = self.step()
+            moved = self._step()
             if not np.isfinite(moved):
                 raise SimulationError("the iteration produced non-finite positions")
             if callback is not None and callback(self, moved) is False:
