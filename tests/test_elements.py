@@ -483,3 +483,55 @@ def test_polar_rotation_matches_the_svd_kabsch_rotation(cond):
         r = np.array(polar_rotation(*a.ravel())).reshape(3, 3)
         np.testing.assert_allclose(r, best_rotation(a), atol=10 * cond * np.finfo(float).eps)
         assert np.linalg.det(r) == pytest.approx(1.0, abs=1e-12)
+
+
+@pytest.mark.parametrize("cond", [1.0, 1e3, 1e6])
+@pytest.mark.parametrize("inverted", [False, True])
+def test_fitted_rotation_matches_the_svd_kabsch_rotation(cond, inverted):
+    """The quaternion fit (+ polishing, or its polar/SVD fallbacks) equals the
+    Kabsch rotation U·diag(1, 1, det(UVᵀ))·Vᵀ to the problem's conditioning.
+
+    The proper rotation's sensitivity is ‖A‖/(σ₂ ± σ₃) (+ for det > 0, − for an
+    inverted A), kept ≤ 2·cond here (σ₃ = 1/(2 cond) ≤ σ₂/2), so the allowed gap
+    is 20·cond·ε. ``upper``
+    is any bound ≥ Horn's largest eigenvalue: drawn 1e-12…1 above it.
+    """
+    from elements._rotation import best_rotation, fitted_rotation
+
+    rng = np.random.default_rng(int(cond) + inverted)
+    eps = np.finfo(float).eps
+    for _ in range(300):
+        q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+        v, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+        sigma = np.array([1.0, rng.uniform(1.0 / cond, 1.0), 0.5 / cond])
+        if np.linalg.det(q @ v.T) > 0 if inverted else np.linalg.det(q @ v.T) < 0:
+            v[:, 2] = -v[:, 2]
+        a = q @ np.diag(sigma) @ v.T * 10.0 ** rng.uniform(-6, 6)
+        s = np.linalg.svd(a, compute_uv=False)
+        lam = s[0] + s[1] + np.sign(np.linalg.det(a)) * s[2]
+        upper = lam * (1.0 + 10.0 ** rng.uniform(-12, 0))
+        r = np.array(fitted_rotation(*a.ravel(), upper)).reshape(3, 3)
+        np.testing.assert_allclose(r, best_rotation(a), atol=20 * cond * eps)
+        np.testing.assert_allclose(r @ r.T, np.eye(3), atol=1e-14)
+        assert np.linalg.det(r) == pytest.approx(1.0, abs=1e-12)
+
+
+@pytest.mark.parametrize("rank", [0, 1, 2])
+def test_fitted_rotation_of_degenerate_covariances_is_a_rotation(rank):
+    """Coincident (rank 0), collinear (1) or coplanar-with-a-zero-singular-value (2)
+    covariances have a non-unique best rotation: any proper rotation reaching
+    the optimum tr(Rᵀ A) = σ₁ + σ₂ + σ₃ will do, and no NaN may come out."""
+    from elements._rotation import fitted_rotation
+
+    rng = np.random.default_rng(rank)
+    for _ in range(100):
+        q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+        v, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+        sigma = np.array([1.0, 0.5, 0.0])[:3] * (np.arange(3) < rank)
+        a = q @ np.diag(sigma) @ v.T
+        upper = sigma.sum() + 1.0
+        r = np.array(fitted_rotation(*a.ravel(), upper)).reshape(3, 3)
+        assert np.isfinite(r).all()
+        np.testing.assert_allclose(r @ r.T, np.eye(3), atol=1e-12)
+        assert np.linalg.det(r) == pytest.approx(1.0, abs=1e-12)
+        assert np.trace(r.T @ a) == pytest.approx(sigma.sum(), abs=1e-12)

@@ -75,7 +75,8 @@ def test_first_failure_angle_matches_eq8(assignment, side):
 def test_accelerated_strategy_finds_the_first_failure_by_a_fold_percent_sweep():
     """lbfgs is checked where each run ends (its iterates are not physical states), so
     a sweep of the target in 1 % steps of 90° finds θ_f within one step (0.9°) plus
-    the converged hinge's own error (< 0.1°)."""
+    the converged hinge's own error (< 0.1°, either side: the 50 % step's target
+    is θ_f itself, where the strain meets the limit to rounding)."""
     pattern, mesh = hinge(90.0, exact_arc=False, assignment="V")
     sim = Simulation(mesh, pattern, solver="lbfgs",
                      strain_limits=StrainLimits(tension=eq8_limit(THETA_F)))
@@ -86,7 +87,7 @@ def test_accelerated_strategy_finds_the_first_failure_by_a_fold_percent_sweep():
             break
     (failure,) = result.failures
     assert failure["fold_percent"] == percent
-    assert THETA_F <= failure["fold_angle_deg"] < THETA_F + 0.9 + 0.1
+    assert THETA_F - 0.1 <= failure["fold_angle_deg"] < THETA_F + 0.9 + 0.1
 
 
 def test_no_failure_below_the_limits_and_report_lists_strains():
