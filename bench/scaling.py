@@ -28,10 +28,11 @@ CHOLMOD's allocations, unlike tracemalloc) is that size's alone. In it:
   round timing (interleaved, so load changes on the shared machine hit all
   alike) one ``sim.step()`` (``step``), the same iteration done by its pieces
   — ``projection`` (every group's ``_GroupRun.project``: the numba element
-  kernels), ``gather`` (``System.rhs`` + the anchor pin term), ``solve``
-  (``system.factor.solve`` of the (N, 3) rhs) — and a ``bare_solve`` (the
-  CHOLMOD forward/back solve of an (N, 3) C-contiguous rhs on the same
-  factor); then ``projection_1thread`` / ``gather_1thread``: the same two
+  kernels), ``gather`` (``System.rhs`` into the column-major rhs + the anchor
+  pin term), ``solve`` (``system.factor.solve`` of that (N, 3) rhs), ``take``
+  (``system.take_solution``: the C-ordered positions and the largest move in
+  one pass) — and a ``bare_solve`` (the CHOLMOD forward/back solve of an
+  (N, 3) column-major rhs, CHOLMOD's own layout, on the same factor); then ``projection_1thread`` / ``gather_1thread``: the same two
   kernels again on one numba thread (``Simulation`` uses numba's default,
   2 here, above its SERIAL_BELOW_SLOTS element-vertex slots); medians per
   iteration, s. ``step_vs_bare_solve`` is the ratio of the two medians
@@ -40,6 +41,10 @@ CHOLMOD's allocations, unlike tracemalloc) is that size's alone. In it:
 * memory: peak RSS (MB) after setup and at the end; ``mb_per_vertex`` =
   (peak − baseline) / thick-mesh vertices. nnz(K) and nnz(L) are read after
   the peak was recorded (L() makes a copy).
+
+The whole child runs with BLAS on one thread, as ``Simulation.step`` does
+(``foldcore.threads``: OpenBLAS's spinning threads otherwise take a core from
+numba's projection).
 
 The machine is shared: before each size the parent waits (up to
 QUIET_WAIT_S) until other jobs use < QUIET_BELOW of the cores, and records
@@ -71,7 +76,7 @@ import numpy as np
 
 RESULTS = Path(__file__).parent / "results"
 SIZES = (5, 10, 20, 50, 100, 150, 200, 300, 400)
-STOP_AFTER_S = 180.0       # stop growing once one size took longer than this (wall, total)
+STOP_AFTER_S = 600.0       # stop growing once one size took longer than this (wall, total)
 CHILD_TIMEOUT_S = 1800.0
 EDGE, GAMMA, TILT = 10.0, 60.0, 30.0     # mm, degrees, degrees
 THICKNESS, WIDTH, SUBDIVISIONS = 1.0, 2.0, 4
@@ -85,7 +90,7 @@ FIT_FROM_N = 10
 QUIET_BELOW, QUIET_WAIT_S = 0.25, 300.0  # before each size, wait for other jobs to calm down
 SETUP_PARTS = ("pattern", "actuate", "thicken", "assembly", "slots", "symbolic", "numeric",
                "factor", "simulation", "total")
-ITERATION_PARTS = ("step", "projection", "gather", "solve", "bare_solve",
+ITERATION_PARTS = ("step", "projection", "gather", "solve", "take", "bare_solve",
                    "projection_1thread", "gather_1thread")
 
 
@@ -154,15 +159,18 @@ def one_round(sim) -> dict:
     """Time one step, one iteration by its pieces and one bare solve (seconds).
 
     Then the projection and gather once more on one numba thread (same x), to
-    show what the second thread buys at this size.
+    show what the second thread buys at this size. Called with BLAS held to
+    one thread, as ``Simulation.step`` runs (``foldcore.threads``).
     """
     import numba
+
+    from foldcore.system import take_solution
 
     t = {}
     t0 = time.perf_counter()
     sim.step()
     t["step"] = time.perf_counter() - t0
-    # the paper iteration by pieces (what Simulation.local_step/global_step do)
+    # the paper iteration by pieces (what Simulation._paper_iteration does)
     numba.set_num_threads(sim.threads)
     x = sim.x
     t0 = time.perf_counter()
@@ -172,11 +180,14 @@ def one_round(sim) -> dict:
     rhs = sim.system.rhs(sim._targets, sim._rhs)
     sim._add_pin_terms(rhs, x)
     t2 = time.perf_counter()
-    new_x = np.ascontiguousarray(sim.system.factor.solve(rhs))
+    solution = sim.system.factor.solve(rhs)
     t3 = time.perf_counter()
+    new_x = np.empty_like(x)
+    take_solution(solution, x, new_x)
+    t4 = time.perf_counter()
     sim.x = new_x
-    t["projection"], t["gather"], t["solve"] = t1 - t0, t2 - t1, t3 - t2
-    bare_rhs = np.ascontiguousarray(new_x)
+    t["projection"], t["gather"], t["solve"], t["take"] = t1 - t0, t2 - t1, t3 - t2, t4 - t3
+    bare_rhs = np.asfortranarray(new_x)  # CHOLMOD's own layout, as the iteration's rhs
     t0 = time.perf_counter()
     sim.system.factor.solve(bare_rhs)
     t["bare_solve"] = time.perf_counter() - t0
@@ -192,6 +203,16 @@ def one_round(sim) -> dict:
 
 
 def child(n: int) -> dict:
+    import scipy.sparse.linalg  # noqa: F401  (loads scipy's BLAS before the guard scans)
+
+    import foldcore.simulation  # noqa: F401
+    from foldcore.threads import blas_on_one_thread
+
+    with blas_on_one_thread(refresh=True):
+        return _child(n)
+
+
+def _child(n: int) -> dict:
     start = time.perf_counter()
     load_start = os.getloadavg()[0]
     # warm-up: imports, numba cache loads, first factorisation, shapely
@@ -240,7 +261,8 @@ def child(n: int) -> dict:
                                          / per_iteration["projection"]),
         "step_vs_bare_solve": per_iteration["step"] / per_iteration["bare_solve"],
         "pieces_vs_bare_solve": (per_iteration["projection"] + per_iteration["gather"]
-                                 + per_iteration["solve"]) / per_iteration["bare_solve"],
+                                 + per_iteration["solve"] + per_iteration["take"])
+        / per_iteration["bare_solve"],
         "rss_baseline_mb": baseline,
         "rss_after_setup_mb": after_setup,
         "peak_rss_mb": peak,

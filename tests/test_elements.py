@@ -535,3 +535,23 @@ def test_fitted_rotation_of_degenerate_covariances_is_a_rotation(rank):
         np.testing.assert_allclose(r @ r.T, np.eye(3), atol=1e-12)
         assert np.linalg.det(r) == pytest.approx(1.0, abs=1e-12)
         assert np.trace(r.T @ a) == pytest.approx(sigma.sum(), abs=1e-12)
+
+
+@pytest.mark.parametrize("n", [1, 7, 1000])
+def test_take_solution_copies_to_c_order_and_returns_the_largest_move(n):
+    """The paper iteration's last pass: C-ordered copy of the (column-major) solve
+    result and max |new − old| in one go; a non-finite value must surface as NaN
+    (the run stops on it) and not be lost in the maximum."""
+    from foldcore.system import take_solution
+
+    rng = np.random.default_rng(n)
+    previous = rng.normal(size=(n, 3))
+    solution = np.asfortranarray(previous + rng.normal(scale=1e-3, size=(n, 3)))
+    out = np.empty((n, 3))
+    moved = take_solution(solution, previous, out)
+    np.testing.assert_array_equal(out, solution)
+    assert moved == np.abs(solution - previous).max()
+    solution[n // 2, 1] = np.nan
+    assert np.isnan(take_solution(solution, previous, out))
+    solution[n // 2, 1] = np.inf
+    assert np.isnan(take_solution(solution, previous, out))

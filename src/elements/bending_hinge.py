@@ -99,22 +99,41 @@ def limit_excess(x, indptr, indices, params, out):
 
 @njit(cache=True)
 def bent_shape(rest, width, phi, exact_arc, out):
-    """Write the strip bent by ``phi`` (rad) into ``out`` (m, 3), centred, local frame."""
+    """Write the strip bent by ``phi`` (rad) into ``out`` (m, 3), centred, local frame.
+
+    Exact arc: a point at (x, y) goes to ((1 − κy) sin ψ / κ, 2 sin²(ψ/2)/κ + y cos ψ)
+    with κ = φ/W and ψ = κx, from s = sin(ψ/2), c = cos(ψ/2) (sin ψ = 2sc,
+    cos ψ = 1 − 2s², no cancellation at small ψ); the pair is computed once per
+    distinct rest x (a strip has two: its vertices share x across the thickness
+    and along the crease) and kept in ``out``'s rows meanwhile.
+    """
     m = rest.shape[0]
     kappa = phi / width
-    for k in range(m):
-        x, y, z = rest[k, 0], rest[k, 1], rest[k, 2]
-        if not exact_arc:
-            out[k, 0] = x * (1.0 - 2.0 * y / width * math.tan(0.5 * phi))
+    if exact_arc and abs(kappa) * width >= 1e-12:
+        for k in range(m):  # pass 1: (sin ψ, cos ψ, 2 sin²(ψ/2)) per vertex
+            shared = -1
+            for j in range(k):
+                if rest[j, 0] == rest[k, 0]:
+                    shared = j
+                    break
+            if shared >= 0:
+                out[k, 0], out[k, 1], out[k, 2] = out[shared, 0], out[shared, 1], out[shared, 2]
+            else:
+                half = 0.5 * kappa * rest[k, 0]
+                sh, ch = math.sin(half), math.cos(half)
+                out[k, 0], out[k, 1], out[k, 2] = 2.0 * sh * ch, 1.0 - 2.0 * sh * sh, 2.0 * sh * sh
+        for k in range(m):  # pass 2: the bent point
+            y = rest[k, 1]
+            sin_psi, cos_psi, versine = out[k, 0], out[k, 1], out[k, 2]
+            out[k, 0] = (1.0 - kappa * y) * sin_psi / kappa
+            out[k, 1] = versine / kappa + y * cos_psi
+            out[k, 2] = rest[k, 2]
+    else:
+        for k in range(m):
+            x, y = rest[k, 0], rest[k, 1]
+            out[k, 0] = x * (1.0 - 2.0 * y / width * math.tan(0.5 * phi)) if not exact_arc else x
             out[k, 1] = y
-        elif abs(kappa) * width < 1e-12:
-            out[k, 0] = x
-            out[k, 1] = y
-        else:
-            psi = kappa * x
-            out[k, 0] = (1.0 - kappa * y) * math.sin(psi) / kappa
-            out[k, 1] = 2.0 * math.sin(0.5 * psi) ** 2 / kappa + y * math.cos(psi)
-        out[k, 2] = z
+            out[k, 2] = rest[k, 2]
     for d in range(2):
         mean = 0.0
         for k in range(m):

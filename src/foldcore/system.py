@@ -8,11 +8,15 @@ through a vertex→slot CSR (each vertex sums its own slots: no races).
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import scipy.sparse as sp
 from numba import njit, prange
 
 from .linsolve import Factor
+
+TAKE_CHUNKS = 64  # blocks of vertices :func:`take_solution` splits among threads
 
 
 def element_matrix(groups, weights, n_vertices: int):
@@ -59,6 +63,42 @@ def gather(v_indptr, v_slots, slot_weight, targets, rhs):
         rhs[v, 0] = a0
         rhs[v, 1] = a1
         rhs[v, 2] = a2
+
+
+@njit(parallel=True, cache=True)
+def take_solution(solution, previous, out):
+    """out[:] = solution and the largest |solution − previous| (mm), in one pass.
+
+    Parameters
+    ----------
+    solution : (N, 3) float, mm, any layout (CHOLMOD returns column-major)
+    previous : (N, 3) float, mm
+    out : (N, 3) float, C-contiguous, written
+
+    Returns
+    -------
+    float
+        max over vertices and axes of |solution − previous|, mm; NaN when
+        ``solution`` holds a non-finite value.
+    """
+    n = solution.shape[0]
+    chunks = min(n, TAKE_CHUNKS)
+    largest = np.zeros(max(chunks, 1))
+    for c in prange(chunks):
+        m, finite = 0.0, True
+        for v in range(c * n // chunks, (c + 1) * n // chunks):
+            for d in range(3):
+                value = solution[v, d]
+                out[v, d] = value
+                finite = finite and math.isfinite(value)
+                m = max(m, abs(value - previous[v, d]))
+        largest[c] = m if finite else math.nan
+    result = 0.0
+    for c in range(len(largest)):  # serial: a parallel max() reduction drops NaN
+        if math.isnan(largest[c]):
+            return math.nan
+        result = max(result, largest[c])
+    return result
 
 
 class System:
@@ -136,6 +176,7 @@ class System:
         return self.matrix @ x + self._pins[:, None] * x
 
     def rhs(self, targets: np.ndarray, out: np.ndarray) -> np.ndarray:
-        """Gather Σ w·(R T) per vertex from the stacked slot targets (nnz, 3)."""
+        """Gather Σ w·(R T) per vertex from the stacked slot targets (nnz, 3) into
+        ``out`` (N, 3); column-major ``out`` is what CHOLMOD reads without a copy."""
         gather(self.v_indptr, self.v_slots, self.slot_weight, targets, out)
         return out
