@@ -198,7 +198,8 @@ def quaternion_fit(a, b, c, d, e, f, g, h, i, upper):
         q2 = -_det(m11, n12, n14, n12, m22, n24, n13, n23, n34)
         q3 = d4
     norm = math.sqrt(q0 * q0 + q1 * q1 + q2 * q2 + q3 * q3)
-    return True, q0 / norm, q1 / norm, q2 / norm, q3 / norm
+    inv = 1.0 / norm
+    return True, q0 * inv, q1 * inv, q2 * inv, q3 * inv
 
 @njit(cache=True)
 def polish_quaternion(a, b, c, d, e, f, g, h, i, w, x, y, z):
@@ -229,16 +230,18 @@ def polish_quaternion(a, b, c, d, e, f, g, h, i, w, x, y, z):
         det = _det(m00, m01, m02, m01, m11, m12, m02, m12, m22)
         if not det > 0.0:
             break
-        o0 = _det(s0, m01, m02, s1, m11, m12, s2, m12, m22) / det
-        o1 = _det(m00, s0, m02, m01, s1, m12, m02, s2, m22) / det
-        o2 = _det(m00, m01, s0, m01, m11, s1, m02, m12, s2) / det
+        inv = 1.0 / det
+        o0 = _det(s0, m01, m02, s1, m11, m12, s2, m12, m22) * inv
+        o1 = _det(m00, s0, m02, m01, s1, m12, m02, s2, m22) * inv
+        o2 = _det(m00, m01, s0, m01, m11, s1, m02, m12, s2) * inv
         p1, p2, p3 = 0.5 * o0, 0.5 * o1, 0.5 * o2
         nw = w - x * p1 - y * p2 - z * p3
         nx = w * p1 + x + y * p3 - z * p2
         ny = w * p2 - x * p3 + y + z * p1
         nz = w * p3 + x * p2 - y * p1 + z
         n = math.sqrt(nw * nw + nx * nx + ny * ny + nz * nz)
-        w, x, y, z = nw / n, nx / n, ny / n, nz / n
+        inv = 1.0 / n
+        w, x, y, z = nw * inv, nx * inv, ny * inv, nz * inv
         if o0 * o0 + o1 * o1 + o2 * o2 <= POLISH_TOL * POLISH_TOL:
             break
     return w, x, y, z
