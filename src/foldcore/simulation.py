@@ -484,7 +484,8 @@ class Simulation:
         return self._bare_solve[1]
 
     def bare_solve_seconds(self, repeats: int = BARE_SOLVE_REPEATS) -> float:
-        """Median time (s) of one K⁻¹ solve of an (N, 3) right-hand side: the cost floor.
+        """Median time (s) of one K⁻¹ solve of an (N, 3) column-major right-hand side
+        (the layout the iterations hand the solver): the cost floor.
 
         ``Result.timings_s["bare_solve"]``; the report divides the mean
         iteration time by it (``per_iteration_vs_bare_solve``).
