@@ -555,3 +555,25 @@ def test_take_solution_copies_to_c_order_and_returns_the_largest_move(n):
     assert np.isnan(take_solution(solution, previous, out))
     solution[n // 2, 1] = np.inf
     assert np.isnan(take_solution(solution, previous, out))
+
+
+@pytest.mark.parametrize("scale", [1e-12, 1e-8, 1.0, 1e6])
+def test_fit_rotated_is_scale_free_between_the_current_shape_and_its_target(scale):
+    """A current shape much smaller (or larger) than its target — a collapsed
+    element, or one far from its rest size — still gets the Kabsch rotation:
+    the root search must not start so far above λ that it stops before it
+    (found by review: with p = 1e-12·R t, 132 of 200 fits were wrong)."""
+    from elements._rotation import best_rotation, fit_rotated
+
+    rng = np.random.default_rng(int(-np.log10(scale)) + 20)
+    for _ in range(200):
+        target = rng.normal(size=(8, 3))
+        target -= target.mean(axis=0)
+        rot, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+        rot *= np.sign(np.linalg.det(rot))
+        x = scale * (target @ rot.T + 0.05 * rng.normal(size=(8, 3))) + 3.0 * scale
+        out = np.empty_like(target)
+        fit_rotated(x, np.arange(8), target, out)
+        centred = x - x.mean(axis=0)
+        expected = target @ best_rotation(centred.T @ target).T
+        np.testing.assert_allclose(out, expected, atol=1e-11 * np.abs(target).max())

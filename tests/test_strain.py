@@ -76,7 +76,7 @@ def test_accelerated_strategy_finds_the_first_failure_by_a_fold_percent_sweep():
     """lbfgs is checked where each run ends (its iterates are not physical states), so
     a sweep of the target in 1 % steps of 90° finds θ_f within one step (0.9°) plus
     the converged hinge's own error (< 0.1°, either side: the 50 % step's target
-    is θ_f itself, where the strain meets the limit to rounding)."""
+    is θ_f itself, so the reported mean angle is θ_f ± that error)."""
     pattern, mesh = hinge(90.0, exact_arc=False, assignment="V")
     sim = Simulation(mesh, pattern, solver="lbfgs",
                      strain_limits=StrainLimits(tension=eq8_limit(THETA_F)))

@@ -47,3 +47,50 @@ def test_serial_simulation_leaves_blas_alone(miura_sim):
         seen = []
         sim.run(max_iterations=2, callback=lambda s, moved: seen.append(_blas_threads()))
         assert seen and all(t == before for t in seen)
+
+
+def test_overlapping_guards_from_two_threads_restore_the_original_setting(monkeypatch):
+    """A opens, B opens, A closes, B closes: BLAS must end where it started (a
+    per-guard save/restore would leave it on one thread for good). A stand-in
+    controller records the setting: OpenBLAS itself ignores a raise of its
+    thread count requested from a non-main thread (measured), which would hide
+    the logic under test."""
+    import threading
+
+    import foldcore.threads as threads
+
+    setting = {"threads": 2}
+
+    class Limiter:
+        def __init__(self):
+            self.original = setting["threads"]
+            setting["threads"] = 1
+
+        def restore_original_limits(self):
+            setting["threads"] = self.original
+
+    class Controller:
+        def limit(self, limits, user_api):
+            assert (limits, user_api) == (1, "blas")
+            return Limiter()
+
+    monkeypatch.setattr(threads, "_controller", Controller())
+    a_open, b_open, a_closed = threading.Event(), threading.Event(), threading.Event()
+    seen = {}
+
+    def guard_b():
+        a_open.wait()
+        with threads.blas_on_one_thread():
+            b_open.set()
+            a_closed.wait()
+            seen["b_after_a_closed"] = setting["threads"]
+
+    worker = threading.Thread(target=guard_b)
+    worker.start()
+    with threads.blas_on_one_thread():
+        a_open.set()
+        b_open.wait()
+    a_closed.set()
+    worker.join()
+    assert seen["b_after_a_closed"] == 1
+    assert setting["threads"] == 2 and threads._depth == 0

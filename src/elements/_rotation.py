@@ -9,16 +9,17 @@ The rotation maximising tr(Rᵀ A) is found as Horn's unit quaternion: the
 largest root of the 4×4 key matrix's characteristic polynomial by Newton from
 an upper bound (Theobald 2005, "Rapid calculation of RMSDs using a
 quaternion-based characteristic polynomial"), its eigenvector from the
-adjugate, then one Newton step on the rotation itself to bring the
-eigenvector's error, ε(λ/gap)², to the conditioning of the problem, ε·λ/gap
-(:func:`quaternion_fit`, :func:`polish_quaternion`). It always gives a proper
+adjugate, then Newton steps on the rotation itself (one or two; at most
+``POLISH_MAX``) to bring the eigenvector's error, ε(λ/gap)², to the
+conditioning of the problem, ε·λ/gap (:func:`quaternion_fit`,
+:func:`polish_quaternion`). It always gives a proper
 rotation (det = +1), also for inverted elements. Measured on the hinge kernel
 (Miura 50 × 50, 19 600 strips, one thread): the rotation fit took 7.4 ms with
 the scaled Newton polar iteration X ← ½(γX + X⁻ᵀ/γ) (Higham 1986), which needs
 6–7 iterations per element, and 3.3 ms this way.
 
 Where the eigen-gap is tiny (nearly collinear or coincident points:
-κ = Π(λⱼ − λ) < ``GAP_MIN`` λ³) the Newton polar factor is used instead, and
+|κ| < ``GAP_MIN`` λ³, κ = Π(λⱼ − λ)) the Newton polar factor is used instead, and
 where the covariance is inverted or nearly singular (det ≤ ``DEGENERATE``
 ‖A‖³) the SVD with its det flip.
 """
@@ -113,14 +114,17 @@ def quaternion_fit(a, b, c, d, e, f, g, h, i, upper):
 
     The largest eigenvalue λ of Horn's symmetric 4×4 matrix N(A) is the root
     of its characteristic polynomial λ⁴ − 2‖A‖²λ² − 8 det(A) λ + det N found by
-    Newton from ``upper`` (any bound ≥ λ, e.g. (Σ‖p‖² + Σ‖t‖²)/2: from above
-    the quartic is increasing and convex, so the steps fall monotonically onto
-    the root; near-fits start within rounding of it); the eigenvector is the
-    column of adj(N − λI) with the largest diagonal entry (Theobald 2005, "Rapid
-    calculation of RMSDs using a quaternion-based characteristic polynomial").
-    Returns (ok, w, x, y, z); ok is False when the trace of that adjugate,
-    κ = Π(λⱼ − λ), is below ``GAP_MIN`` λ³: a near-double root (nearly collinear
-    or coincident points), where the eigenvector is ill-determined. Its error
+    Newton from min(``upper``, √3‖A‖_F) (``upper``: any bound ≥ λ, e.g.
+    (Σ‖p‖² + Σ‖t‖²)/2, within rounding of λ on near-fits; √3‖A‖_F keeps the
+    start within 3 λ when the current shape is tiny against the target): from
+    above the quartic is increasing and convex, so the steps fall
+    monotonically onto the root. The eigenvector is the column of adj(N − λI)
+    with the largest diagonal entry (Theobald 2005, "Rapid calculation of RMSDs
+    using a quaternion-based characteristic polynomial"). Returns (ok, w, x,
+    y, z); ok is False when the root search does not settle within
+    ``ROOT_MAX`` steps or when |κ|, κ = Π(λⱼ − λ) the trace of that adjugate,
+    is below ``GAP_MIN`` λ³: a near-double root (nearly collinear or
+    coincident points), where the eigenvector is ill-determined. Its error
     grows like ε(λ/gap)², so :func:`polish_quaternion` refines it.
     """
     # Horn's N is built from S = Aᵀ (S = Σ t pᵀ: target t onto current p)
@@ -154,17 +158,24 @@ def quaternion_fit(a, b, c, d, e, f, g, h, i, upper):
     t4 = n23 * n44 - n34 * n24
     t5 = n33 * n44 - n34 * n34
     c0 = s0 * t5 - s1 * t4 + s2 * t3 + s3 * t2 - s4 * t1 + s5 * t0
-    lam = upper
+    # start ≤ 3 λ whatever the scale of ``upper``: λ ≥ σ₁ ≥ ‖A‖_F/√3 and
+    # λ ≤ σ₁ + σ₂ + σ₃ ≤ √3 ‖A‖_F (from far above, Newton on a quartic only
+    # shrinks λ by ¾ per step)
+    lam = min(upper, math.sqrt(3.0 * fro))
+    converged = False
     for _ in range(ROOT_MAX):
         l2 = lam * lam
         p = (l2 + c2) * l2 + c1 * lam + c0
         dp = (4.0 * l2 + 2.0 * c2) * lam + c1
-        if not dp > 0.0:
+        if not dp > 0.0:  # a (near-)double root: leave it to the fallback
             break
         step = p / dp
         lam -= step
         if abs(step) <= ROOT_TOL * abs(lam):
+            converged = True
             break
+    if not converged:
+        return False, 1.0, 0.0, 0.0, 0.0
     # adjugate of M = N − λI: column with the largest diagonal cofactor
     m11, m22, m33, m44 = n11 - lam, n22 - lam, n33 - lam, n44 - lam
     # principal minors (diagonal of adj)

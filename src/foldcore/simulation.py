@@ -58,9 +58,11 @@ class Result:
     energy : (iterations,) float, energy before each global step, mm⁵
     iterations : int
     converged : bool
-    timings_s : dict with ``setup``, ``projection``, ``solve``, ``total`` (setup + every
-        :meth:`Simulation.run` so far) and, after
-        :meth:`Simulation.run`, ``bare_solve`` (one K⁻¹ solve, the floor) (seconds)
+    timings_s : dict with ``setup``, ``projection`` (element kernels), ``solve`` (the
+        rhs gather, the K⁻¹ solve and, for ``paper``, taking its result and
+        largest move), ``total`` (setup + every :meth:`Simulation.run` so far)
+        and, after :meth:`Simulation.run`, ``bare_solve`` (one K⁻¹ solve, the
+        floor) (seconds)
     strip_strains : (S, 2) float, top and bottom surface strain of each hinge
         sub-strip from its current shape (:mod:`foldcore.strain`), dimensionless
     failures : list of dict, hinges that exceeded their strain limits (first
@@ -356,7 +358,7 @@ class Simulation:
         energy, rhs = self.local_step(self.x)
         t0 = time.perf_counter()
         solution = self.system.factor.solve(rhs)
-        new_x = np.empty_like(self.x)
+        new_x = np.empty(self.x.shape)
         moved = float(take_solution(solution, self.x, new_x))
         self.timings["solve"] += time.perf_counter() - t0
         self.x = new_x
