@@ -17,12 +17,14 @@ SOLVERS = ("paper", "anderson", "lbfgs", "rigid", "hybrid")
 #: rigid phase brings long panels and closed loops to the rigid-body model's
 #: state in a few iterations whatever the panel length (single hinge to 0.01°
 #: in 3–8 iterations at Lp/H = 5–320 and the thin waterbomb in 34, where
-#: ``lbfgs`` alone needs 31–2 000 and never in 20 000, ``paper`` 10 280 and
+#: ``lbfgs`` alone needs 31–1 980 and never in 20 000, ``paper`` 10 280 and
 #: never), and its L-BFGS phase then settles
 #: on the paper's own energy, so it ends at the paper model's equilibria
 #: (passive creases: Eq. 9 per sub-strip), with every element type (meshes
-#: the rigid phase cannot take run L-BFGS alone). On every benchmark scene it
-#: is at least as close to the closed form as ``lbfgs`` and ``paper``. Cost:
+#: the rigid phase cannot take run L-BFGS alone). On every benchmark scene
+#: but one it is at least as close to the closed form as ``lbfgs`` and
+#: ``paper``; on Pehrson's vertex driven flat both stop ~97° short, at
+#: different equilibria of the thick model (hybrid 97.2°, lbfgs 96.8°). Cost:
 #: a rigid step is a sparse Gauss–Newton solve, ~11–13 µs per thick vertex
 #: (Miura 20×20, 7.8 k vertices: 85 ms in bench/convergence; 50×50, 49.6 k:
 #: 0.62 s, profiled over 3 steps), so on
