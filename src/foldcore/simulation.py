@@ -428,7 +428,7 @@ class Simulation:
         self.timings.setdefault("total", self.timings["setup"])
         budget, limit = int(max_iterations), tolerance * self.length_scale
         moved, stopped = np.inf, False
-        with blas_on_one_thread(self.threads > 1, refresh=True):
+        with blas_on_one_thread(self.threads > 1):
             if self._rigid_phase and budget > 0:
                 used, moved, stopped = self._hybrid_rigid_phase(tolerance, budget, callback)
                 budget -= used

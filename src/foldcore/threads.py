@@ -20,7 +20,9 @@ from __future__ import annotations
 import threading
 from contextlib import contextmanager, nullcontext
 
-_controller = None  # threadpoolctl.ThreadpoolController, built on first use
+# threadpoolctl.ThreadpoolController, built on first use: by then a Simulation
+# exists, and building one loads numpy's and scipy's BLAS (checked)
+_controller = None
 _limiter = None  # the active limit while any guard is open
 _depth = 0  # guards open in this process (nested, or from several Python threads)
 _lock = threading.Lock()
