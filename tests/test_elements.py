@@ -301,6 +301,37 @@ def test_kernel_equals_numpy_twin(name, kind):
             np.testing.assert_allclose(state, state_n, rtol=0, atol=1e-12, err_msg=label)
 
 
+PREPARED = [n for n in TYPES if elements.get(n).prepared_batch is not None]
+
+
+@pytest.mark.parametrize("kind", KINDS)
+@pytest.mark.parametrize("name", PREPARED)
+def test_prepared_batch_gives_what_batch_gives_to_the_last_bit(name, kind):
+    """The engine projects through prepare + prepared_batch: it must not change a bit."""
+    etype = elements.get(name)
+    for seed in range(2):
+        for label, x, g, params in states(name, kind, seed):
+            params = np.ascontiguousarray(params, dtype=np.float64)
+            x = np.ascontiguousarray(x, dtype=np.float64)
+            shapes = np.full_like(g.rest, np.nan)  # rows prepare leaves alone stay unread
+            etype.prepare(g.indptr, g.rest, params, shapes)
+            n = len(g.indptr) - 1
+            out, energy = np.zeros((len(g.indices), 3)), np.zeros(n)
+            state = np.zeros((n, len(etype.state)))
+            etype.prepared_batch(x, g.indptr, g.indices, g.rest, shapes, params, out,
+                                 energy, state)
+            expected = run(name, x, g, params)
+            for got, want in zip((out, energy, state), expected):
+                np.testing.assert_array_equal(got, want, err_msg=label)
+
+
+def test_prepare_without_prepared_batch_is_refused(saved_registry):
+    with pytest.raises(TypeError, match="both"):
+        class HalfPrepared(elements.ElementType):
+            name = "test_half_prepared"
+            prepare = staticmethod(lambda *a: None)
+
+
 def test_twin_states_cover_the_clamps():
     """The soup really holds wrong-side M/V estimates and angles beyond max_angle."""
     x, g, p = soup("bending_hinge", [g for _, _, g in groups_of("bending_hinge")],

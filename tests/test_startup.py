@@ -28,7 +28,7 @@ p = patterns.single_hinge(panel_length=5.0, depth=2.0, angle=45.0, width=2.0)
 sim = Simulation(thicken(p, 1.0, subdivisions=2), p)
 sim.run(tolerance=0, max_iterations=3)
 misses = {f.__name__ + "@" + f.__module__: sum(f.stats.cache_misses.values())
-          for f in (bh.batch, bh.limit_excess, rp.batch, system.gather)}
+          for f in (bh.prepare, bh.prepared_batch, bh.limit_excess, rp.batch, system.gather)}
 print(json.dumps(misses))
 """
 

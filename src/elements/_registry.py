@@ -27,17 +27,31 @@ class ElementType:
     batch : callable
         The numba batch loop ``batch(x, indptr, indices, rest, params, out,
         energy, state)``; see the package docstring.
+    prepare, prepared_batch : callable or None
+        Optional pair, for types whose targets partly depend on parameters
+        only (an actuated hinge's bent shape): ``prepare(indptr, rest,
+        params, shapes)`` writes those elements' target shapes (local frame,
+        centred) into their rows of ``shapes`` (nnz, 3); the engine calls it
+        once per change of ``params`` and then, every iteration,
+        ``prepared_batch(x, indptr, indices, rest, shapes, params, out,
+        energy, state)`` instead of ``batch``, which must give what ``batch``
+        gives. Both or neither.
     """
 
     name: str = ""
     params: tuple = ()
     state: tuple = ()
     batch = None
+    prepare = None
+    prepared_batch = None
 
     def __init_subclass__(cls, **kwargs):
         super().__init_subclass__(**kwargs)
         if not cls.name:
             raise TypeError(f"{cls.__qualname__} must set a non-empty `name`")
+        if (cls.prepare is None) != (cls.prepared_batch is None):
+            raise TypeError(f"{cls.__qualname__} must set both `prepare` and "
+                            "`prepared_batch`, or neither")
         old = _REGISTRY.get(cls.name)
         if old is not None and old is not cls:
             warnings.warn(f"element type {cls.name!r} from {cls.__module__} replaces the "

@@ -173,6 +173,46 @@ def batch(x, indptr, indices, rest, params, out, energy, state):
         energy[e] = project(x, indices[s:t], rest[s:t], params[e], out[s:t], state[e])
 
 
+@njit(parallel=True, cache=True)
+def prepare(indptr, rest, params, shapes):
+    """Bent shape of every actuated strip into its rows of ``shapes`` (nnz, 3), mm.
+
+    Local frame, centred, as :func:`project` makes it: an actuated strip's
+    target depends on its parameters only, so the engine computes it here
+    once per change of targets instead of every iteration (~0.12 µs per strip
+    per iteration, measured on Miura 50 × 50). Passive strips' rows are not
+    written.
+    """
+    for e in prange(len(indptr) - 1):
+        phi = params[e, TARGET]
+        if not math.isnan(phi):
+            s, t = indptr[e], indptr[e + 1]
+            bent_shape(rest[s:t], params[e, W], phi, params[e, EXACT] > 0.5, shapes[s:t])
+
+
+@njit(cache=True)
+def project_prepared(x, ids, rest, shape, params, out, state):
+    """:func:`project` with an actuated strip's bent ``shape`` (m, 3) from :func:`prepare`.
+
+    Same arithmetic, so the same result to the last bit; passive strips are
+    projected by :func:`project` itself.
+    """
+    phi = params[TARGET]
+    if math.isnan(phi):
+        return project(x, ids, rest, params, out, state)
+    state[0] = phi
+    return fit_rotated(x, ids, shape, out)
+
+
+@njit(parallel=True, cache=True)
+def prepared_batch(x, indptr, indices, rest, shapes, params, out, energy, state):
+    """:func:`batch` with the actuated strips' bent shapes taken from ``shapes``."""
+    for e in prange(len(indptr) - 1):
+        s, t = indptr[e], indptr[e + 1]
+        energy[e] = project_prepared(x, indices[s:t], rest[s:t], shapes[s:t], params[e],
+                                     out[s:t], state[e])
+
+
 SHAPE_STEP = 1e-6  # rad, central-difference step of ``shapes``' derivative
 
 
@@ -214,3 +254,5 @@ class BendingHinge(ElementType):
     state = ("angle",)
     batch = batch
     project = project
+    prepare = prepare
+    prepared_batch = prepared_batch

@@ -81,7 +81,12 @@ class Result:
 
 
 class _GroupRun:
-    """Run-time arrays of one element group: parameters, outputs, state."""
+    """Run-time arrays of one element group: parameters, outputs, state.
+
+    For a type with a ``prepare`` kernel (see :class:`elements.ElementType`),
+    also the prepared target shapes, recomputed on the first projection after
+    :meth:`set_params` changed the parameters (write them only through it).
+    """
 
     def __init__(self, group, offset: int):
         self.group = group
@@ -90,11 +95,24 @@ class _GroupRun:
         self.energy = np.zeros(len(group))
         self.state = np.zeros((len(group), len(self.etype.state)))
         self.slots = slice(offset, offset + len(group.indices))
+        self._shapes = None  # prepared target shapes (nnz, 3), mm; None: stale
+
+    def set_params(self, rows, column: int, values) -> None:
+        """``params[rows, column] = values``; the prepared shapes follow on next use."""
+        self.params[rows, column] = values
+        self._shapes = None
 
     def project(self, x, targets, weights):
-        g = self.group
-        self.etype.batch(x, g.indptr, g.indices, g.rest, self.params, targets[self.slots],
-                         self.energy, self.state)
+        g, etype = self.group, self.etype
+        if etype.prepared_batch is None:
+            etype.batch(x, g.indptr, g.indices, g.rest, self.params, targets[self.slots],
+                        self.energy, self.state)
+        else:
+            if self._shapes is None:
+                self._shapes = np.zeros_like(g.rest)
+                etype.prepare(g.indptr, g.rest, self.params, self._shapes)
+            etype.prepared_batch(x, g.indptr, g.indices, g.rest, self._shapes, self.params,
+                                 targets[self.slots], self.energy, self.state)
         return float(self.energy @ weights)
 
 
@@ -242,7 +260,7 @@ class Simulation:
             if ratio is not None and not (np.isfinite(ratio) and ratio > 0):
                 raise SimulationError(f"edge {e}: stretch ratio must be a positive number, "
                                       f"got {ratio!r}")
-            run.params[rows, RATIO] = np.nan if ratio is None else float(ratio)
+            run.set_params(rows, RATIO, np.nan if ratio is None else float(ratio))
         self._targets_changed()
 
     def stretch_ratios(self) -> np.ndarray:
@@ -613,7 +631,7 @@ class Simulation:
         src = self._hinges.group.source
         k = self.mesh.subdivisions[src]
         target = np.radians(self._fold_targets[src] * self._percent / 100.0) / k
-        self._hinges.params[:, TARGET] = target
+        self._hinges.set_params(slice(None), TARGET, target)
         self._passive = np.isnan(target)
 
     def _init_stops(self, stop_stiffness: float) -> None:
@@ -649,7 +667,7 @@ class Simulation:
             raise SimulationError(f"passive floor must be ≥ 0 degrees, got {floor_deg!r}")
         if self._hinges is not None:
             k = self.mesh.subdivisions[self._hinges.group.source]
-            self._hinges.params[:, FLOOR] = np.radians(floor_deg) / k
+            self._hinges.set_params(slice(None), FLOOR, np.radians(floor_deg) / k)
 
     def _update_pins(self) -> None:
         weights = np.zeros(self.mesh.n_vertices)
