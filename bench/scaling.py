@@ -18,7 +18,8 @@ CHOLMOD's allocations, unlike tracemalloc) is that size's alone. In it:
   (``patterns.miura``), ``actuate`` (``pattern.replace(fold_angles=...)``,
   re-validates), ``thicken``, ``assembly`` (``system.element_matrix``),
   ``slots`` (``system.vertex_slots``, the gather's CSR), ``symbolic``
-  (``sksparse.cholmod.analyze``, simplicial, default ordering) and
+  (``sksparse.cholmod.analyze``, simplicial, the ordering
+  ``linsolve.cholmod_ordering`` picks) and
   ``numeric`` (``Factor.cholesky_inplace``) on K + the anchor pin,
   ``factor`` (one ``linsolve.Factor(...)`` construction, both at once) and
   ``simulation`` (the whole ``Simulation(mesh, pattern)`` construction,
@@ -117,7 +118,7 @@ def setup_once(n: int):
     from sksparse.cholmod import analyze
 
     from foldcore import thicken
-    from foldcore.linsolve import Factor
+    from foldcore.linsolve import Factor, cholmod_ordering
     from foldcore.simulation import Simulation
     from foldcore.system import element_matrix, vertex_slots
 
@@ -139,7 +140,7 @@ def setup_once(n: int):
     pins[0] = matrix.diagonal().mean()  # the anchor Simulation adds without position targets
     pinned = (matrix + sp.diags(pins)).tocsc()
     t0 = time.perf_counter()
-    factor = analyze(pinned, mode="simplicial")
+    factor = analyze(pinned, mode="simplicial", ordering_method=cholmod_ordering(n_vertices))
     t1 = time.perf_counter()
     factor.cholesky_inplace(pinned)
     t2 = time.perf_counter()

@@ -1,0 +1,252 @@
+"""What a fused projection + scatter would buy (issue 7's last 0.1–0.3×): a measured prototype.
+
+DESIGN.md's element contract has every kernel write its rotated target into
+its own rows of a targets array, and the rhs *gathered* per vertex afterwards
+(race-free). The alternative measured here is outside that contract: elements
+are coloured so that no two of one colour share a vertex, and each element
+adds w·R·T straight into the (column-major) rhs as soon as it is projected —
+one parallel loop per colour, no gather pass. Variant ``fused_cached`` also
+takes the actuated hinges' bent shapes from a per-slot array computed once
+(they change only when the targets do), which the contract has no place for
+either (element state is output-only).
+
+Scene: the Miura-ori of ``bench/scaling.py`` (same builder), paper solver, the
+Simulation's own thread count. Each round times, interleaved: the contract's
+iteration by pieces (projection, gather + anchor pin, solve, take), the fused
+iteration (zero the rhs, one parallel loop per colour per group, anchor pin,
+solve, take), the fused one with cached bent shapes, and a bare solve; medians
+over ROUNDS rounds after WARM rounds. Checks first that the fused rhs equals
+the gathered one (relative 1e-12): the prototype computes the same iteration.
+
+Run: ``.venv/bin/python bench/fused_prototype.py [--sizes 50 100 200]``;
+writes bench/results/fused_prototype.json. Not part of the library: a
+prototype to decide whether the contract change is worth it.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import statistics
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+from numba import njit, prange
+
+from elements._rotation import fit_rotated
+
+sys.path.insert(0, str(Path(__file__).parent))
+from _meta import machine_meta  # noqa: E402
+from scaling import setup_once  # noqa: E402
+
+RESULTS = Path(__file__).parent / "results"
+WARM, ROUNDS = 3, 20
+MAX_COLOURS = 63
+
+
+@njit(cache=True)
+def colour_elements(indptrs, indices_list, n_vertices, colours_out):
+    """Greedy colouring over all groups: no two elements of one colour share a vertex.
+
+    Elements are visited group by group in index order; each takes the lowest
+    colour none of its vertices has yet (a per-vertex bit mask). Returns the
+    number of colours used, or -1 above MAX_COLOURS.
+    """
+    used = np.zeros(n_vertices, dtype=np.int64)
+    n_colours = 0
+    for g in range(len(indptrs)):
+        indptr, indices, out = indptrs[g], indices_list[g], colours_out[g]
+        for e in range(len(indptr) - 1):
+            mask = 0
+            for k in range(indptr[e], indptr[e + 1]):
+                mask |= used[indices[k]]
+            c = 0
+            while mask & (1 << c):
+                c += 1
+            if c > MAX_COLOURS:
+                return -1
+            out[e] = c
+            for k in range(indptr[e], indptr[e + 1]):
+                used[indices[k]] |= 1 << c
+            n_colours = max(n_colours, c + 1)
+    return n_colours
+
+
+def make_fused(project):
+    """A parallel loop over some elements of a group: project, then add w·R·T into rhs."""
+
+    @njit(parallel=True)
+    def fused(x, indptr, indices, rest, params, weights, elements, targets, energy, state, rhs):
+        for j in prange(len(elements)):
+            e = elements[j]
+            s, t = indptr[e], indptr[e + 1]
+            energy[e] = project(x, indices[s:t], rest[s:t], params[e], targets[s:t], state[e])
+            w = weights[e]
+            for k in range(s, t):
+                v = indices[k]
+                rhs[v, 0] += w * targets[k, 0]
+                rhs[v, 1] += w * targets[k, 1]
+                rhs[v, 2] += w * targets[k, 2]
+
+    return fused
+
+
+@njit(parallel=True)
+def fused_fixed_shape(x, indptr, indices, shapes, weights, elements, targets, energy, rhs):
+    """Like ``make_fused`` with each element's (centred) target shape precomputed."""
+    for j in prange(len(elements)):
+        e = elements[j]
+        s, t = indptr[e], indptr[e + 1]
+        energy[e] = fit_rotated(x, indices[s:t], shapes[s:t], targets[s:t])
+        w = weights[e]
+        for k in range(s, t):
+            v = indices[k]
+            rhs[v, 0] += w * targets[k, 0]
+            rhs[v, 1] += w * targets[k, 1]
+            rhs[v, 2] += w * targets[k, 2]
+
+
+class Fused:
+    """The fused iteration's data: per group, its elements split by colour."""
+
+    def __init__(self, sim, cached: bool):
+        from elements.bending_hinge import shapes as hinge_shapes
+
+        runs = sim._runs
+        self.sim, self.cached = sim, cached
+        colours = [np.empty(len(r.group), dtype=np.int64) for r in runs]
+        from numba.typed import List
+        self.n_colours = colour_elements(List([r.group.indptr for r in runs]),
+                                         List([r.group.indices for r in runs]),
+                                         sim.mesh.n_vertices, List(colours))
+        assert self.n_colours > 0, "too many colours"
+        self.by_colour = [[np.flatnonzero(c == k) for k in range(self.n_colours)]
+                          for c in colours]
+        self.kernels = [make_fused(r.etype.project) for r in runs]
+        self.shapes = []
+        for r in runs:
+            g = r.group
+            if cached and r.etype.name == "bending_hinge":
+                assert not np.isnan(r.params[:, 2]).any(), "every strip actuated here"
+                d_out = np.empty_like(g.rest)
+                out = np.empty_like(g.rest)
+                hinge_shapes(g.indptr, g.rest, r.params, r.params[:, 2], out, d_out)
+                self.shapes.append(out)
+            elif cached and r.etype.name == "rigid_panel":
+                self.shapes.append(np.ascontiguousarray(g.rest))
+            else:
+                self.shapes.append(None)
+
+    def rhs(self, x, rhs):
+        sim = self.sim
+        rhs[:] = 0.0
+        for k in range(self.n_colours):
+            for gi, (r, w) in enumerate(zip(sim._runs, sim.system.weights)):
+                elems = self.by_colour[gi][k]
+                if not len(elems):
+                    continue
+                g = r.group
+                if self.shapes[gi] is not None:
+                    fused_fixed_shape(x, g.indptr, g.indices, self.shapes[gi], w, elems,
+                                      sim._targets[r.slots], r.energy, rhs)
+                else:
+                    self.kernels[gi](x, g.indptr, g.indices, g.rest, r.params, w, elems,
+                                     sim._targets[r.slots], r.energy, r.state, rhs)
+        sim._add_pin_terms(rhs, x)
+        return rhs
+
+
+def contract_iteration(sim, x, t):
+    from foldcore.system import take_solution
+
+    t0 = time.perf_counter()
+    for run, w in zip(sim._runs, sim.system.weights):
+        run.project(x, sim._targets, w)
+    t1 = time.perf_counter()
+    rhs = sim.system.rhs(sim._targets, sim._rhs)
+    sim._add_pin_terms(rhs, x)
+    t2 = time.perf_counter()
+    solution = sim.system.factor.solve(rhs)
+    new_x = np.empty_like(x)
+    take_solution(solution, x, new_x)
+    t3 = time.perf_counter()
+    t["contract"] = t3 - t0
+    t["contract_projection"], t["contract_gather"] = t1 - t0, t2 - t1
+    return new_x
+
+
+def fused_iteration(sim, fused, x, t, key):
+    from foldcore.system import take_solution
+
+    t0 = time.perf_counter()
+    rhs = fused.rhs(x, sim._rhs)
+    t1 = time.perf_counter()
+    solution = sim.system.factor.solve(rhs)
+    new_x = np.empty_like(x)
+    take_solution(solution, x, new_x)
+    t[key] = time.perf_counter() - t0
+    t[key + "_projection_scatter"] = t1 - t0
+    return new_x
+
+
+def measure(n: int) -> dict:
+    import numba
+
+    _, mesh, pattern, sim = setup_once(n)
+    sim.mesh = mesh
+    numba.set_num_threads(sim.threads)
+    plain, cached = Fused(sim, cached=False), Fused(sim, cached=True)
+    x = sim.x.copy()
+    for run, w in zip(sim._runs, sim.system.weights):
+        run.project(x, sim._targets, w)
+    reference = sim.system.rhs(sim._targets, np.zeros_like(sim._rhs)).copy()
+    sim._add_pin_terms(reference, x)
+    scale = np.abs(reference).max()
+    errors = {}
+    for name, f in (("fused", plain), ("fused_cached", cached)):
+        got = f.rhs(x, np.zeros_like(sim._rhs, order="F")).copy()
+        errors[name] = float(np.abs(got - reference).max() / scale)
+        assert errors[name] < 1e-12, (name, errors[name])
+    rounds = []
+    for i in range(WARM + ROUNDS):
+        t = {}
+        x = contract_iteration(sim, x, t)
+        fused_iteration(sim, plain, x, t, "fused")
+        fused_iteration(sim, cached, x, t, "fused_cached")
+        rhs = np.asfortranarray(x)
+        t0 = time.perf_counter()
+        sim.system.factor.solve(rhs)
+        t["bare_solve"] = time.perf_counter() - t0
+        if i >= WARM:
+            rounds.append(t)
+    med = {k: statistics.median(r[k] for r in rounds) for k in rounds[0]}
+    return {"n": n, "thick_vertices": int(mesh.n_vertices), "threads": int(sim.threads),
+            "colours": plain.n_colours, "rhs_relative_difference": errors,
+            "median_s": med,
+            "vs_bare_solve": {k: med[k] / med["bare_solve"]
+                              for k in ("contract", "fused", "fused_cached")}}
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--sizes", type=int, nargs="+", default=[50, 100, 200])
+    args = parser.parse_args()
+    import scipy.sparse.linalg  # noqa: F401  (scipy's BLAS loaded before the guard scans)
+
+    import foldcore.simulation  # noqa: F401
+    from foldcore.threads import blas_on_one_thread
+
+    rows = []
+    with blas_on_one_thread(refresh=True):
+        for n in args.sizes:
+            row = measure(n)
+            print(json.dumps({k: row[k] for k in ("n", "colours", "vs_bare_solve")}), flush=True)
+            rows.append(row)
+    RESULTS.mkdir(exist_ok=True)
+    (RESULTS / "fused_prototype.json").write_text(json.dumps(
+        {"meta": machine_meta(), "rows": rows}, indent=1))
+
+
+if __name__ == "__main__":
+    main()
