@@ -5,10 +5,13 @@ its own rows of a targets array, and the rhs *gathered* per vertex afterwards
 (race-free). The alternative measured here is outside that contract: elements
 are coloured so that no two of one colour share a vertex, and each element
 adds w·R·T straight into the (column-major) rhs as soon as it is projected —
-one parallel loop per colour, no gather pass. Variant ``fused_cached`` also
-takes the actuated hinges' bent shapes from a per-slot array computed once
-(they change only when the targets do), which the contract has no place for
-either (element state is output-only).
+one parallel loop per colour, no gather pass. ``contract`` is the engine's
+own iteration (since the bending hinge's ``prepare``, actuated strips' bent
+shapes are computed once, not per iteration); ``fused`` projects with the
+plain kernels (bent shapes every iteration) and scatters; ``fused_cached``
+takes every element's target shape from a per-slot array computed once and
+scatters: the like-for-like comparison with ``contract`` (same shape work,
+colour-scatter instead of gather).
 
 Scene: the Miura-ori of ``bench/scaling.py`` (same builder), paper solver, the
 Simulation's own thread count. Each round times, interleaved: the contract's
@@ -18,8 +21,8 @@ solve, take), the fused one with cached bent shapes, and a bare solve; medians
 over ROUNDS rounds after WARM rounds. Checks first that the fused rhs equals
 the gathered one (relative 1e-12): the prototype computes the same iteration.
 
-Run: ``.venv/bin/python bench/fused_prototype.py [--sizes 50 100 200]``;
-writes bench/results/fused_prototype.json. Not part of the library: a
+Run: ``.venv/bin/python bench/fused_prototype.py [--sizes 50 100 200]``
+(~6 min); writes bench/results/fused_prototype.json and .png. Not part of the library: a
 prototype to decide whether the contract change is worth it.
 """
 from __future__ import annotations
@@ -228,6 +231,31 @@ def measure(n: int) -> dict:
                               for k in ("contract", "fused", "fused_cached")}}
 
 
+def plot(rows, path: Path) -> None:
+    """Per-iteration time of each variant as a multiple of the bare solve, per size."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    variants = ("contract", "fused", "fused_cached")
+    fig, ax = plt.subplots(figsize=(7, 4.5))
+    width = 0.8 / len(variants)
+    for i, name in enumerate(variants):
+        ax.bar([j + i * width for j in range(len(rows))],
+               [r["vs_bare_solve"][name] for r in rows], width, label=name)
+    ax.axhline(1.3, color="k", ls="--", lw=1, label="issue 7 target (1.3×)")
+    ax.set_xticks([j + width for j in range(len(rows))])
+    ax.set_xticklabels([f"{r['n']}×{r['n']}\n{r['thick_vertices']:,} vertices" for r in rows])
+    ax.set_ylabel("iteration time / bare CHOLMOD solve")
+    ax.set_ylim(1.0, None)
+    ax.set_title("Gather (contract) vs colour-fused scatter, Miura n×n, medians")
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--sizes", type=int, nargs="+", default=[50, 100, 200])
@@ -246,6 +274,7 @@ def main() -> None:
     RESULTS.mkdir(exist_ok=True)
     (RESULTS / "fused_prototype.json").write_text(json.dumps(
         {"meta": machine_meta(), "rows": rows}, indent=1))
+    plot(rows, RESULTS / "fused_prototype.png")
 
 
 if __name__ == "__main__":

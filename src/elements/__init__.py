@@ -6,7 +6,9 @@ An element type is a small module holding
   rotated target shape, writing only its own rows;
 * a module-level ``@njit(parallel=True, cache=True)`` batch loop with the
   signature ``batch(x, indptr, indices, rest, params, out, energy, state)``;
-* a subclass of :class:`ElementType` naming the kernel and its metadata.
+* a subclass of :class:`ElementType` naming the kernel and its metadata;
+* optionally, a ``prepare`` / ``prepared_batch`` pair for targets that partly
+  depend on parameters only (computed once per change, not per iteration).
 
 Defining the subclass registers it. Third-party packages can also register
 types through the ``foldcore.elements`` entry-point group (loaded lazily, on the
