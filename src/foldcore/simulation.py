@@ -95,12 +95,13 @@ class _GroupRun:
         self.energy = np.zeros(len(group))
         self.state = np.zeros((len(group), len(self.etype.state)))
         self.slots = slice(offset, offset + len(group.indices))
-        self._shapes = None  # prepared target shapes (nnz, 3), mm; None: stale
+        self._shapes = None  # prepared target shapes (nnz, 3), mm, allocated on first use
+        self._prepared = False  # whether _shapes matches params
 
     def set_params(self, rows, column: int, values) -> None:
         """``params[rows, column] = values``; the prepared shapes follow on next use."""
         self.params[rows, column] = values
-        self._shapes = None
+        self._prepared = False
 
     def project(self, x, targets, weights):
         g, etype = self.group, self.etype
@@ -108,9 +109,11 @@ class _GroupRun:
             etype.batch(x, g.indptr, g.indices, g.rest, self.params, targets[self.slots],
                         self.energy, self.state)
         else:
-            if self._shapes is None:
-                self._shapes = np.zeros_like(g.rest)
+            if not self._prepared:
+                if self._shapes is None:
+                    self._shapes = np.zeros_like(g.rest)
                 etype.prepare(g.indptr, g.rest, self.params, self._shapes)
+                self._prepared = True
             etype.prepared_batch(x, g.indptr, g.indices, g.rest, self._shapes, self.params,
                                  targets[self.slots], self.energy, self.state)
         return float(self.energy @ weights)
