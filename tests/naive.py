@@ -11,7 +11,12 @@ HINGE_PARAMS = ("width", "height", "target", "sign", "max_angle", "floor", "exac
 
 def kabsch(p, t):
     """Rotation R (det +1) minimising Σ‖p_k − R t_k‖² for centred (m, 3) p, t."""
-    u, _, vt = np.linalg.svd(p.T @ t)
+    return kabsch_of(p.T @ t)
+
+
+def kabsch_of(cov):
+    """Rotation R (det +1) maximising tr(Rᵀ cov): U·diag(1, 1, det(U Vᵀ))·Vᵀ."""
+    u, _, vt = np.linalg.svd(cov)
     d = np.sign(np.linalg.det(u @ vt))
     return u @ np.diag([1.0, 1.0, d]) @ vt
 

@@ -495,25 +495,69 @@ def test_registry_left_untouched():
     assert "test_fresh_type" not in elements.registered()
 
 
+def random_covariance(rng, sigma, inverted):
+    """Q·diag(sigma)·Vᵀ with random orthogonal Q, V; det < 0 iff ``inverted``."""
+    q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+    v, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+    if (np.linalg.det(q @ v.T) > 0) == inverted:
+        v[:, 2] = -v[:, 2]
+    return q @ np.diag(sigma) @ v.T
+
+
+def assert_best_rotation(r, a, atol):
+    """r is a proper rotation reaching the optimum tr(Rᵀ a) = σ₁ + σ₂ ± σ₃, and
+    equals the Kabsch rotation within ``atol`` where that one is unique (atol
+    given from the problem's sensitivity; None: several rotations are optimal)."""
+    s = np.linalg.svd(a, compute_uv=False)
+    np.testing.assert_allclose(r @ r.T, np.eye(3), atol=1e-13)
+    assert np.linalg.det(r) == pytest.approx(1.0, abs=1e-12)
+    optimum = s[0] + s[1] + np.sign(np.linalg.det(a)) * s[2]
+    assert np.trace(r.T @ a) == pytest.approx(optimum, abs=1e-13 * s[0])
+    if atol is not None:
+        np.testing.assert_allclose(r, naive.kabsch_of(a), atol=atol)
+
+
 @pytest.mark.parametrize("cond", [1.0, 1e3, 1e6])
-def test_polar_rotation_matches_the_svd_kabsch_rotation(cond):
-    """The allocation-free Newton polar factor equals U·diag(1,1,±1)·Vᵀ.
+@pytest.mark.parametrize("inverted", [False, True])
+def test_polar_rotation_is_the_best_rotation(cond, inverted):
+    """The allocation-free Newton polar factor (det > 0) and its Jacobi fallback
+    (inverted A) give the Kabsch rotation U·diag(1,1,det(UVᵀ))·Vᵀ.
 
-    Both are exact up to rounding; the polar factor's sensitivity is
-    ‖A‖/(σ₂+σ₃) ≤ cond, so the allowed gap is 10·cond·ε. Inverted matrices
-    (det < 0) take the SVD path and must still give det = +1.
+    The proper rotation's sensitivity is ‖A‖/(σ₂ + σ₃) for det > 0 (≤ cond
+    here) and ‖A‖/(σ₂ − σ₃) for an inverted A, so the allowed gap is 10·ε
+    times that; with σ₂ = σ₃ (cond = 1, inverted) every rotation about one
+    axis is optimal and only the optimum is checked.
     """
-    from elements._rotation import best_rotation, polar_rotation
+    from elements._rotation import polar_rotation
 
-    rng = np.random.default_rng(int(cond))
-    for k in range(300):
-        q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
-        v, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+    rng = np.random.default_rng(int(cond) + inverted)
+    eps = np.finfo(float).eps
+    for _ in range(300):
         sigma = np.array([1.0, rng.uniform(1.0 / cond, 1.0), 1.0 / cond])
-        a = q @ np.diag(sigma) @ v.T * 10.0 ** rng.uniform(-6, 6)
+        a = random_covariance(rng, sigma, inverted) * 10.0 ** rng.uniform(-6, 6)
+        gap = sigma[1] - sigma[2] if inverted else sigma[1] + sigma[2]
         r = np.array(polar_rotation(*a.ravel())).reshape(3, 3)
-        np.testing.assert_allclose(r, best_rotation(a), atol=10 * cond * np.finfo(float).eps)
-        assert np.linalg.det(r) == pytest.approx(1.0, abs=1e-12)
+        assert_best_rotation(r, a, 10 * eps / gap if gap > 1e-6 else None)
+
+
+@pytest.mark.parametrize("rank", [0, 1, 2, 3])
+@pytest.mark.parametrize("inverted", [False, True])
+def test_jacobi_rotation_is_the_best_rotation(rank, inverted):
+    """The rare path (inverted or nearly singular A) called directly: Horn's
+    quaternion from a Jacobi eigen-decomposition reaches the optimum for every
+    rank, inverted or not, and is the Kabsch rotation where that is unique
+    (sensitivity ‖A‖/(σ₂ ∓ σ₃) ≤ 4 here: allowed gap 40·ε)."""
+    from elements._rotation import jacobi_rotation
+
+    rng = np.random.default_rng(10 * rank + inverted)
+    eps = np.finfo(float).eps
+    for _ in range(300):
+        sigma = np.array([1.0, rng.uniform(0.5, 1.0), rng.uniform(0.0, 0.25)])
+        sigma[rank:] = 0.0
+        a = random_covariance(rng, sigma, inverted) * 10.0 ** rng.uniform(-6, 6)
+        r = np.array(jacobi_rotation(*a.ravel())).reshape(3, 3)
+        assert np.isfinite(r).all()
+        assert_best_rotation(r, a, 40 * eps if rank >= 2 else None)
 
 
 @pytest.mark.parametrize("cond", [1.0, 1e3, 1e6])
@@ -527,7 +571,7 @@ def test_fitted_rotation_matches_the_svd_kabsch_rotation(cond, inverted):
     is 20·cond·ε. ``upper``
     is any bound ≥ Horn's largest eigenvalue: drawn 1e-12…1 above it.
     """
-    from elements._rotation import best_rotation, fitted_rotation
+    from elements._rotation import fitted_rotation
 
     rng = np.random.default_rng(int(cond) + inverted)
     eps = np.finfo(float).eps
@@ -542,7 +586,7 @@ def test_fitted_rotation_matches_the_svd_kabsch_rotation(cond, inverted):
         lam = s[0] + s[1] + np.sign(np.linalg.det(a)) * s[2]
         upper = lam * (1.0 + 10.0 ** rng.uniform(-12, 0))
         r = np.array(fitted_rotation(*a.ravel(), upper)).reshape(3, 3)
-        np.testing.assert_allclose(r, best_rotation(a), atol=20 * cond * eps)
+        np.testing.assert_allclose(r, naive.kabsch_of(a), atol=20 * cond * eps)
         np.testing.assert_allclose(r @ r.T, np.eye(3), atol=1e-14)
         assert np.linalg.det(r) == pytest.approx(1.0, abs=1e-12)
 
@@ -594,7 +638,7 @@ def test_fit_rotated_is_scale_free_between_the_current_shape_and_its_target(scal
     element, or one far from its rest size — still gets the Kabsch rotation:
     the root search must not start so far above λ that it stops before it
     (found by review: with p = 1e-12·R t, 132 of 200 fits were wrong)."""
-    from elements._rotation import best_rotation, fit_rotated
+    from elements._rotation import fit_rotated
 
     rng = np.random.default_rng(int(-np.log10(scale)) + 20)
     for _ in range(200):
@@ -606,5 +650,5 @@ def test_fit_rotated_is_scale_free_between_the_current_shape_and_its_target(scal
         out = np.empty_like(target)
         fit_rotated(x, np.arange(8), target, out)
         centred = x - x.mean(axis=0)
-        expected = target @ best_rotation(centred.T @ target).T
+        expected = target @ naive.kabsch_of(centred.T @ target).T
         np.testing.assert_allclose(out, expected, atol=1e-11 * np.abs(target).max())

@@ -21,14 +21,18 @@ the scaled Newton polar iteration X ← ½(γX + X⁻ᵀ/γ) (Higham 1986), whic
 Where the eigen-gap is tiny (nearly collinear or coincident points:
 |κ| < ``GAP_MIN`` λ³, κ = Π(λⱼ − λ)) the Newton polar factor is used instead, and
 where the covariance is inverted or nearly singular (det ≤ ``DEGENERATE``
-‖A‖³) the SVD with its det flip.
+‖A‖³) Horn's quaternion again, its eigenvector found by cyclic Jacobi
+rotations of the 4×4 key matrix (:func:`jacobi_rotation`), which any
+(repeated) eigenvalue leaves well-defined. That rare path used to be
+``np.linalg.svd`` with a det flip, whose numba compilation alone took 3.5 s
+of a cold first fold (measured 2026-11-25).
 """
 import math
 
 import numpy as np
 from numba import njit
 
-DEGENERATE = 1e-14  # det(A)/‖A‖_F³ below which the SVD path is taken
+DEGENERATE = 1e-14  # det(A)/‖A‖_F³ below which the Jacobi path is taken
 NEWTON_TOL = 1e-15  # relative Frobenius change that ends the Newton iteration
 NEWTON_MAX = 30  # iterations cap (quadratic convergence: ~6–9 are used)
 GAP_MIN = 1e-4  # κ/λ³ (~ relative eigen-gap) below which the quaternion path hands over
@@ -36,26 +40,8 @@ ROOT_TOL = 1e-14  # relative Newton step on λ that ends the root search
 ROOT_MAX = 60  # root-search cap (from the upper bound: 1–4 steps on near-fits)
 POLISH_TOL = 1e-10  # rad: a refinement step this small ends the refinement
 POLISH_MAX = 4
-
-
-@njit(cache=True)
-def best_rotation(cov):
-    """Rotation R (det = +1) maximising tr(Rᵀ cov), i.e. minimising Σ‖p − R t‖².
-
-    Parameters
-    ----------
-    cov : (3, 3) float64
-        Σ p tᵀ over an element's vertices: p current (centred), t target (centred).
-
-    Returns
-    -------
-    (3, 3) float64
-        Kabsch/Procrustes rotation U·diag(1, 1, det(U Vᵀ))·Vᵀ.
-    """
-    u, _, vt = np.linalg.svd(cov)
-    if np.linalg.det(u) * np.linalg.det(vt) < 0.0:
-        u[:, 2] = -u[:, 2]
-    return u @ vt
+JACOBI_TOL = 1e-15  # off-diagonal / Frobenius norm of N that ends the Jacobi sweeps
+JACOBI_SWEEPS = 30  # cap (cyclic Jacobi converges quadratically: ~4–6 sweeps on 4×4)
 
 
 @njit(cache=True)
@@ -67,15 +53,13 @@ def _det(a, b, c, d, e, f, g, h, i):
 def polar_rotation(a, b, c, d, e, f, g, h, i):
     """Rotation nearest to the row-major 3×3 matrix (a…i), as 9 scalars (row-major).
 
-    Scaled Newton iteration for the polar factor; falls back to the SVD when
-    the matrix is inverted or nearly singular (see the module docstring).
+    Scaled Newton iteration for the polar factor; when the matrix is inverted
+    or nearly singular, :func:`jacobi_rotation` instead (module docstring).
     """
     norm = math.sqrt(a * a + b * b + c * c + d * d + e * e + f * f + g * g + h * h + i * i)
     det = _det(a, b, c, d, e, f, g, h, i)
     if not norm > 0.0 or det <= DEGENERATE * norm ** 3:
-        r = best_rotation(np.array([[a, b, c], [d, e, f], [g, h, i]]))
-        return (r[0, 0], r[0, 1], r[0, 2], r[1, 0], r[1, 1], r[1, 2],
-                r[2, 0], r[2, 1], r[2, 2])
+        return jacobi_rotation(a, b, c, d, e, f, g, h, i)
     for _ in range(NEWTON_MAX):
         det = _det(a, b, c, d, e, f, g, h, i)
         # X⁻ᵀ = cofactor(X) / det(X)
@@ -109,6 +93,78 @@ def quaternion_matrix(w, x, y, z):
             2.0 * (xz - wy), 2.0 * (yz + wx), ww - xx - yy + zz)
 
 @njit(cache=True)
+def horn_matrix(a, b, c, d, e, f, g, h, i):
+    """Upper triangle (n11, n12, n13, n14, n22, n23, n24, n33, n34, n44) of Horn's
+    symmetric 4×4 key matrix N of the row-major A (a…i): qᵀNq = tr(R(q)ᵀ A)."""
+    # built from S = Aᵀ (S = Σ t pᵀ: target t onto current p)
+    sxx, sxy, sxz = a, d, g
+    syx, syy, syz = b, e, h
+    szx, szy, szz = c, f, i
+    return (sxx + syy + szz, syz - szy, szx - sxz, sxy - syx,
+            sxx - syy - szz, sxy + syx, szx + sxz,
+            -sxx + syy - szz, syz + szy,
+            -sxx - syy + szz)
+
+
+@njit(cache=True)
+def jacobi_rotation(a, b, c, d, e, f, g, h, i):
+    """Rotation maximising tr(Rᵀ A) by Horn's quaternion, N diagonalised by Jacobi.
+
+    Cyclic Jacobi rotations (each zeroes one off-diagonal entry of N and
+    accumulates into the eigenvector matrix V) until the off-diagonal part is
+    below ``JACOBI_TOL`` of ‖N‖_F; the quaternion is V's column of the largest
+    diagonal entry, then polished (:func:`polish_quaternion`, which stops at
+    once where the optimum is not isolated). Valid for every A — inverted,
+    rank-deficient, zero (identity) — since a repeated top eigenvalue only
+    means several rotations are optimal. Returns 9 scalars, row-major.
+    """
+    n = np.empty((4, 4))
+    (n[0, 0], n[0, 1], n[0, 2], n[0, 3], n[1, 1], n[1, 2], n[1, 3], n[2, 2], n[2, 3],
+     n[3, 3]) = horn_matrix(a, b, c, d, e, f, g, h, i)
+    for p in range(4):
+        for q in range(p):
+            n[p, q] = n[q, p]
+    v = np.eye(4)
+    for _ in range(JACOBI_SWEEPS):
+        off = total = 0.0
+        for p in range(4):
+            for q in range(4):
+                total += n[p, q] * n[p, q]
+                if p != q:
+                    off += n[p, q] * n[p, q]
+        if not off > JACOBI_TOL * JACOBI_TOL * total:
+            break
+        for p in range(3):
+            for q in range(p + 1, 4):
+                if n[p, q] == 0.0:
+                    continue
+                # rotation J (c, s) in the (p, q) plane with (Jᵀ N J)[p, q] = 0
+                theta = (n[q, q] - n[p, p]) / (2.0 * n[p, q])
+                t = 1.0 / (abs(theta) + math.sqrt(theta * theta + 1.0))
+                if theta < 0.0:
+                    t = -t
+                cos = 1.0 / math.sqrt(t * t + 1.0)
+                sin = t * cos
+                for k in range(4):  # N ← N J, V ← V J
+                    nkp, nkq = n[k, p], n[k, q]
+                    n[k, p], n[k, q] = cos * nkp - sin * nkq, sin * nkp + cos * nkq
+                    vkp, vkq = v[k, p], v[k, q]
+                    v[k, p], v[k, q] = cos * vkp - sin * vkq, sin * vkp + cos * vkq
+                for k in range(4):  # N ← Jᵀ N
+                    npk, nqk = n[p, k], n[q, k]
+                    n[p, k], n[q, k] = cos * npk - sin * nqk, sin * npk + cos * nqk
+    top = 0
+    for k in range(1, 4):
+        if n[k, k] > n[top, top]:
+            top = k
+    w, x, y, z = v[0, top], v[1, top], v[2, top], v[3, top]
+    inv = 1.0 / math.sqrt(w * w + x * x + y * y + z * z)
+    w, x, y, z = polish_quaternion(a, b, c, d, e, f, g, h, i, w * inv, x * inv, y * inv,
+                                   z * inv)
+    return quaternion_matrix(w, x, y, z)
+
+
+@njit(cache=True)
 def quaternion_fit(a, b, c, d, e, f, g, h, i, upper):
     """Horn's quaternion of the rotation maximising tr(Rᵀ A), A the row-major a…i.
 
@@ -127,20 +183,8 @@ def quaternion_fit(a, b, c, d, e, f, g, h, i, upper):
     coincident points), where the eigenvector is ill-determined. Its error
     grows like ε(λ/gap)², so :func:`polish_quaternion` refines it.
     """
-    # Horn's N is built from S = Aᵀ (S = Σ t pᵀ: target t onto current p)
-    sxx, sxy, sxz = a, d, g
-    syx, syy, syz = b, e, h
-    szx, szy, szz = c, f, i
-    n11 = sxx + syy + szz
-    n12 = syz - szy
-    n13 = szx - sxz
-    n14 = sxy - syx
-    n22 = sxx - syy - szz
-    n23 = sxy + syx
-    n24 = szx + sxz
-    n33 = -sxx + syy - szz
-    n34 = syz + szy
-    n44 = -sxx - syy + szz
+    n11, n12, n13, n14, n22, n23, n24, n33, n34, n44 = horn_matrix(a, b, c, d, e, f, g,
+                                                                    h, i)
     fro = a * a + b * b + c * c + d * d + e * e + f * f + g * g + h * h + i * i
     c2 = -2.0 * fro
     c1 = -8.0 * _det(a, b, c, d, e, f, g, h, i)
@@ -265,7 +309,7 @@ def fitted_rotation(a, b, c, d, e, f, g, h, i, upper):
     ``upper`` ≥ the largest eigenvalue of Horn's matrix (see
     :func:`quaternion_fit`). The quaternion fit and one or two polishing
     steps; where its eigen-gap is too small, the Newton polar factor (and its
-    SVD fallback) instead.
+    Jacobi fallback) instead.
     """
     ok, w, x, y, z = quaternion_fit(a, b, c, d, e, f, g, h, i, upper)
     if not ok:
@@ -281,7 +325,7 @@ def fit_rotated(x, ids, target, out):
     ``target`` (m, 3) must be centred; ``out`` may be ``target`` itself (each
     row is read before it is written). The residual
     is Σ‖(x − c) − R·target‖² in mm², the element's unweighted energy.
-    Allocates nothing (except on the rare SVD path).
+    Allocates nothing (except on the rare Jacobi path).
     """
     m = len(ids)
     c0 = c1 = c2 = 0.0
