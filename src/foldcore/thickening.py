@@ -352,6 +352,17 @@ def _prism(ids2d, points, thickness):
     return ids2d, xyz - xyz.mean(axis=0)
 
 
+def _prisms(quads, points, thickness):
+    """Rest coordinates (n, 8, 3) of the quadrilateral prisms on ``quads`` (n, 4)
+    point ids, each centred, world frame: :func:`_prism` for many at once (the
+    same arithmetic: the mean sums the 8 rows in order)."""
+    xy = points[quads]
+    h = np.full(quads.shape + (1,), 0.5 * thickness)
+    xyz = np.concatenate([np.concatenate([xy, h], axis=2), np.concatenate([xy, -h], axis=2)],
+                         axis=1)
+    return xyz - xyz.mean(axis=1, keepdims=True)
+
+
 def _panel_loops(corner_ids, inserts) -> list:
     """Footprint point ids of each panel: its corners with the strip ends inserted."""
     loops = []
@@ -658,35 +669,40 @@ def _polygon_area(xy) -> float:
 
 
 def _hinge_group(pattern, points, strip_points, widths, ks, thickness, exact_arc, stiffness):
+    """The bending-hinge group: k × m sub-strips per crease (m segments along it),
+    built a crease at a time with array operations (a per-strip Python loop took
+    ~1.2 s of 2.3 s of ``thicken`` on Miura 50 × 50), and each crease's strip ids."""
     n_top = len(points)
     loops, rests, params, vols, source, strips_of = [], [], [], [], [], {}
     stiff_e = np.broadcast_to(np.asarray(stiffness, dtype=float), (pattern.n_edges,))
     sign = {"V": 1.0, "M": -1.0, "U": 0.0, "F": 0.0}
+    count = 0
     for e, lines in strip_points.items():
         k = int(ks[e])
-        frame = _hinge_frame(pattern, e)
-        target = pattern.fold_angles[e]
-        if pattern.assignments[e] == "F":
-            target = 0.0
-        m = len(lines[0]) - 1  # segments along the crease
-        strips_of[e] = np.arange(len(loops), len(loops) + k * m, dtype=np.int64)
-        for t in range(m):  # segment-major: each segment's k strips left → right
-            length = float(np.linalg.norm(points[lines[0][t + 1]] - points[lines[0][t]]))
-            for j in range(k):
-                quad = [lines[j][t], lines[j + 1][t], lines[j + 1][t + 1], lines[j][t + 1]]
-                loop2d, rest = _prism(quad, points, thickness)
-                loops.append(np.concatenate([loop2d, loop2d + n_top]))
-                rests.append(rest @ frame)
-                params.append(_hinge_params(widths[e] / k, thickness, target, k,
+        target = 0.0 if pattern.assignments[e] == "F" else pattern.fold_angles[e]
+        grid = np.asarray(lines, dtype=np.int64)  # (k + 1, m + 1): line j, point t
+        m = grid.shape[1] - 1  # segments along the crease
+        strips_of[e] = np.arange(count, count + k * m, dtype=np.int64)
+        count += k * m
+        # segment-major: each segment's k strips left → right
+        quads = np.stack([grid[:-1, :-1].T, grid[1:, :-1].T, grid[1:, 1:].T, grid[:-1, 1:].T],
+                         axis=-1).reshape(k * m, 4)
+        loops.append(np.concatenate([quads, quads + n_top], axis=1))
+        rests.append((_prisms(quads, points, thickness) @ _hinge_frame(pattern, e))
+                     .reshape(-1, 3))
+        params.append(np.tile(_hinge_params(widths[e] / k, thickness, target, k,
                                             sign[pattern.assignments[e]],
-                                            pattern.max_angles[e], exact_arc))
-                vols.append(widths[e] / k * length * thickness)
-                source.append(e)
-    vols = np.array(vols)
-    src = np.array(source, dtype=np.int64)
-    return _group("bending_hinge", loops, rests,
-                  np.array(params).reshape(len(loops), len(HINGE_PARAMS)),
-                  vols, vols * stiff_e[src] if len(src) else vols, src), strips_of
+                                            pattern.max_angles[e], exact_arc), (k * m, 1)))
+        lengths = np.array([float(np.linalg.norm(points[b] - points[a]))
+                            for a, b in zip(grid[0, :-1], grid[0, 1:])])
+        vols.append(np.repeat(widths[e] / k * lengths * thickness, k))
+        source.append(np.full(k * m, e, dtype=np.int64))
+    vols = np.concatenate(vols) if vols else np.zeros(0)
+    src = np.concatenate(source) if source else np.zeros(0, dtype=np.int64)
+    loops = list(np.concatenate(loops)) if loops else []
+    params = np.concatenate(params) if params else np.zeros((0, len(HINGE_PARAMS)))
+    return _group("bending_hinge", loops, rests, params, vols,
+                  vols * stiff_e[src] if len(src) else vols, src), strips_of
 
 
 def _check_stiffness(pattern, stiffness) -> None:
@@ -748,11 +764,17 @@ def _stretch_group(pattern, points, strip_points, stretch, widths, thickness, st
 
 
 def _hinge_frame(pattern, e) -> np.ndarray:
-    """(3, 3) columns: local x (across, toward the left face), y (up), z (along a→b)."""
+    """(3, 3) columns: local x (across, toward the left face), y (up), z (along a→b).
+
+    x = ẑ × u written out (as ``np.cross`` evaluates it, signed zeros included:
+    the call itself cost 44 µs per crease, a third of the hinge group's build).
+    """
     a, b = pattern.edges[e]
     d = pattern.vertices[b] - pattern.vertices[a]
-    u = np.r_[d / np.linalg.norm(d), 0.0]
-    return np.column_stack([np.cross([0.0, 0.0, 1.0], u), [0.0, 0.0, 1.0], u])
+    ux, uy = d / np.linalg.norm(d)
+    return np.array([[0.0 * 0.0 - 1.0 * uy, 0.0, ux],
+                     [1.0 * ux - 0.0 * 0.0, 0.0, uy],
+                     [0.0 * uy - 0.0 * ux, 1.0, 0.0]])
 
 
 def _hinge_params(width, thickness, target_deg, k, sign, max_deg, exact_arc):
