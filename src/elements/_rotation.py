@@ -93,6 +93,7 @@ def quaternion_matrix(w, x, y, z):
             2.0 * (xy + wz), ww - xx + yy - zz, 2.0 * (yz - wx),
             2.0 * (xz - wy), 2.0 * (yz + wx), ww - xx - yy + zz)
 
+
 @njit(cache=True)
 def horn_matrix(a, b, c, d, e, f, g, h, i):
     """Upper triangle (n11, n12, n13, n14, n22, n23, n24, n33, n34, n44) of Horn's
@@ -256,6 +257,7 @@ def quaternion_fit(a, b, c, d, e, f, g, h, i, upper):
     norm = math.sqrt(q0 * q0 + q1 * q1 + q2 * q2 + q3 * q3)
     inv = 1.0 / norm
     return True, q0 * inv, q1 * inv, q2 * inv, q3 * inv
+
 
 @njit(cache=True)
 def polish_quaternion(a, b, c, d, e, f, g, h, i, w, x, y, z):

@@ -343,21 +343,17 @@ def thicken(pattern: CreasePattern, thickness: float, hinge_width=None,
 
 
 def _prism(ids2d, points, thickness):
-    """Vertex ids (top loop, bottom loop) and rest coordinates (centred, world frame)."""
+    """Footprint point ids (m,) and rest coordinates (2m, 3) of one prism: top loop,
+    then bottom loop, centred, world frame."""
     ids2d = np.asarray(ids2d, dtype=np.int64)
-    xy = points[ids2d]
-    h = 0.5 * thickness
-    xyz = np.vstack([np.column_stack([xy, np.full(len(xy), h)]),
-                     np.column_stack([xy, np.full(len(xy), -h)])])
-    return ids2d, xyz - xyz.mean(axis=0)
+    return ids2d, _prisms(ids2d[None], points, thickness)[0]
 
 
-def _prisms(quads, points, thickness):
-    """Rest coordinates (n, 8, 3) of the quadrilateral prisms on ``quads`` (n, 4)
-    point ids, each centred, world frame: :func:`_prism` for many at once (the
-    same arithmetic: the mean sums the 8 rows in order)."""
-    xy = points[quads]
-    h = np.full(quads.shape + (1,), 0.5 * thickness)
+def _prisms(footprints, points, thickness):
+    """Rest coordinates (n, 2m, 3) of the prisms on ``footprints`` (n, m) point ids:
+    each its top loop (z = +H/2) then its bottom loop, centred, world frame."""
+    xy = points[footprints]
+    h = np.full(footprints.shape + (1,), 0.5 * thickness)
     xyz = np.concatenate([np.concatenate([xy, h], axis=2), np.concatenate([xy, -h], axis=2)],
                          axis=1)
     return xyz - xyz.mean(axis=1, keepdims=True)
