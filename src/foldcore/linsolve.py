@@ -7,14 +7,15 @@ analysis (CHOLMOD) when only the values of K change.
 
 Fill-reducing ordering (CHOLMOD): its default (AMD, METIS only when AMD's
 fill looks poor) below ``NESTED_DISSECTION_FROM`` rows, CHOLMOD's nested
-dissection (``nesdis``) from there. Measured on the scaling benchmark's
-Miura-ori K (bench/scaling.py; 2-core Xeon, 2026-11-25), default → nesdis:
-at 88 796 rows (50 × 50) nnz(L) −15 %, solve 4.8 → 4.2 ms, analysis +
-numeric factorisation 169 → 227 ms; at 357 596 rows (100 × 100) nnz(L)
-−21 %, solve 43 → 36 ms, numeric 1.26 → 0.64 s, analysis 0.14 → 0.75 s;
-at 1 435 196 rows (200 × 200) nnz(L) −27 %, solve 220 → 176 ms, analysis
-+ numeric 15.6 → 8.8 s. Below ~50 000 rows the two fill alike (20 × 20:
-−5 %) and nesdis's analysis costs more (3 → 15 ms at 20 × 20).
+dissection (``nesdis``) from there. Measured by ``bench/ordering.py`` on the
+scaling benchmark's Miura-ori K (2-core Xeon, 2026-11-25,
+``bench/results/ordering.json``), default → nesdis: at 88 796 rows
+(50 × 50) nnz(L) −15 %, solve 5.5 → 4.2 ms, analysis + numeric
+factorisation 0.16 → 0.22 s; at 357 596 rows (100 × 100) nnz(L) −21 %,
+solve 43 → 37 ms, numeric 1.30 → 0.63 s, analysis 0.13 → 0.73 s; at
+1 435 196 rows (200 × 200) nnz(L) −27 %, solve 225 → 179 ms, analysis +
+numeric 13.4 → 8.9 s. Below ~50 000 rows the two fill alike (20 × 20: −5 %)
+and nesdis's analysis costs more (3 → 15 ms at 20 × 20).
 """
 from __future__ import annotations
 
