@@ -56,3 +56,27 @@ def test_large_factor_is_ordered_by_nested_dissection():
     used = Factor(matrix, "cholmod")._factor.P()
     assert np.array_equal(used, analyze(matrix, ordering_method="nesdis").P())
     assert not np.array_equal(used, analyze(matrix, ordering_method="default").P())
+
+
+def test_cholmod_without_metis_falls_back_to_its_default_ordering(monkeypatch):
+    """A CHOLMOD built without its partition module raises CholmodNotInstalledError
+    for nesdis: the factorisation must still happen, with the default ordering."""
+    if not cholmod_available():
+        pytest.skip("scikit-sparse not installed")
+    import sksparse.cholmod as cholmod
+
+    real = cholmod.cholesky
+    asked = []
+
+    def without_metis(matrix, *args, ordering_method="default", **kwargs):
+        asked.append(ordering_method)
+        if ordering_method == "nesdis":
+            raise cholmod.CholmodNotInstalledError("no partition module")
+        return real(matrix, *args, ordering_method=ordering_method, **kwargs)
+
+    monkeypatch.setattr(cholmod, "cholesky", without_metis)
+    matrix = grid_laplacian(240)
+    b = np.random.default_rng(1).normal(size=(matrix.shape[0], 3))
+    factor = Factor(matrix, "cholmod")
+    assert asked == ["nesdis", "default"]
+    assert relative_residual(matrix, factor.solve(b), b) < RESIDUAL

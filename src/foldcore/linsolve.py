@@ -15,7 +15,8 @@ factorisation 0.16 → 0.22 s; at 357 596 rows (100 × 100) nnz(L) −21 %,
 solve 43 → 37 ms, numeric 1.30 → 0.63 s, analysis 0.13 → 0.73 s; at
 1 435 196 rows (200 × 200) nnz(L) −27 %, solve 225 → 179 ms, analysis +
 numeric 13.4 → 8.9 s. Below ~50 000 rows the two fill alike (20 × 20: −5 %)
-and nesdis's analysis costs more (3 → 15 ms at 20 × 20).
+and nesdis's analysis costs more (3 → 15 ms at 20 × 20). A CHOLMOD built
+without METIS has no nesdis: the default ordering is used there.
 """
 from __future__ import annotations
 
@@ -66,9 +67,12 @@ class Factor:
             self._factor = splu(matrix, permc_spec="MMD_AT_PLUS_A",
                                 options={"SymmetricMode": True})
         elif self._factor is None:
-            from sksparse.cholmod import cholesky
-            self._factor = cholesky(matrix, mode="simplicial",
-                                    ordering_method=cholmod_ordering(matrix.shape[0]))
+            from sksparse.cholmod import CholmodNotInstalledError, cholesky
+            try:
+                self._factor = cholesky(matrix, mode="simplicial",
+                                        ordering_method=cholmod_ordering(matrix.shape[0]))
+            except CholmodNotInstalledError:  # a CHOLMOD built without METIS: no nesdis
+                self._factor = cholesky(matrix, mode="simplicial")
         else:
             self._factor.cholesky_inplace(matrix)
 
