@@ -41,7 +41,7 @@ from elements._rotation import fit_rotated
 
 sys.path.insert(0, str(Path(__file__).parent))
 from _meta import machine_meta  # noqa: E402
-from scaling import setup_once  # noqa: E402
+from scaling import project_and_gather, setup_once, solve_and_take  # noqa: E402
 
 RESULTS = Path(__file__).parent / "results"
 WARM, ROUNDS = 3, 20
@@ -95,19 +95,13 @@ def make_fused(project):
     return fused
 
 
-@njit(parallel=True)
-def fused_fixed_shape(x, indptr, indices, shapes, weights, elements, targets, energy, rhs):
-    """Like ``make_fused`` with each element's (centred) target shape precomputed."""
-    for j in prange(len(elements)):
-        e = elements[j]
-        s, t = indptr[e], indptr[e + 1]
-        energy[e] = fit_rotated(x, indices[s:t], shapes[s:t], targets[s:t])
-        w = weights[e]
-        for k in range(s, t):
-            v = indices[k]
-            rhs[v, 0] += w * targets[k, 0]
-            rhs[v, 1] += w * targets[k, 1]
-            rhs[v, 2] += w * targets[k, 2]
+@njit
+def project_fixed_shape(x, ids, shape, params, out, state):
+    """The element's precomputed (centred) target ``shape`` rotated onto x[ids]."""
+    return fit_rotated(x, ids, shape, out)
+
+
+fused_fixed_shape = make_fused(project_fixed_shape)
 
 
 class Fused:
@@ -117,7 +111,7 @@ class Fused:
         from elements.bending_hinge import shapes as hinge_shapes
 
         runs = sim._runs
-        self.sim, self.cached = sim, cached
+        self.sim = sim
         colours = [np.empty(len(r.group), dtype=np.int64) for r in runs]
         from numba.typed import List
         self.n_colours = colour_elements(List([r.group.indptr for r in runs]),
@@ -149,47 +143,29 @@ class Fused:
                 elems = self.by_colour[gi][k]
                 if not len(elems):
                     continue
-                g = r.group
-                if self.shapes[gi] is not None:
-                    fused_fixed_shape(x, g.indptr, g.indices, self.shapes[gi], w, elems,
-                                      sim._targets[r.slots], r.energy, rhs)
-                else:
-                    self.kernels[gi](x, g.indptr, g.indices, g.rest, r.params, w, elems,
-                                     sim._targets[r.slots], r.energy, r.state, rhs)
+                g, shapes = r.group, self.shapes[gi]
+                kernel = self.kernels[gi] if shapes is None else fused_fixed_shape
+                kernel(x, g.indptr, g.indices, g.rest if shapes is None else shapes,
+                       r.params, w, elems, sim._targets[r.slots], r.energy, r.state, rhs)
         sim._add_pin_terms(rhs, x)
         return rhs
 
 
 def contract_iteration(sim, x, t):
-    from foldcore.system import take_solution
-
-    t0 = time.perf_counter()
-    for run, w in zip(sim._runs, sim.system.weights):
-        run.project(x, sim._targets, w)
-    t1 = time.perf_counter()
-    rhs = sim.system.rhs(sim._targets, sim._rhs)
-    sim._add_pin_terms(rhs, x)
-    t2 = time.perf_counter()
-    solution = sim.system.factor.solve(rhs)
-    new_x = np.empty_like(x)
-    take_solution(solution, x, new_x)
-    t3 = time.perf_counter()
-    t["contract"] = t3 - t0
-    t["contract_projection"], t["contract_gather"] = t1 - t0, t2 - t1
+    """The engine's iteration by pieces (``scaling``'s helpers) into ``t``; new x."""
+    t["contract_projection"], t["contract_gather"] = project_and_gather(sim, x, sim._rhs)
+    new_x, solve, take = solve_and_take(sim, sim._rhs, x)
+    t["contract"] = t["contract_projection"] + t["contract_gather"] + solve + take
     return new_x
 
 
 def fused_iteration(sim, fused, x, t, key):
-    from foldcore.system import take_solution
-
+    """The fused iteration (projection + colour scatter, solve, take) into ``t``; new x."""
     t0 = time.perf_counter()
     rhs = fused.rhs(x, sim._rhs)
-    t1 = time.perf_counter()
-    solution = sim.system.factor.solve(rhs)
-    new_x = np.empty_like(x)
-    take_solution(solution, x, new_x)
-    t[key] = time.perf_counter() - t0
-    t[key + "_projection_scatter"] = t1 - t0
+    scatter = time.perf_counter() - t0
+    new_x, solve, take = solve_and_take(sim, rhs, x)
+    t[key], t[key + "_projection_scatter"] = scatter + solve + take, scatter
     return new_x
 
 
@@ -197,14 +173,11 @@ def measure(n: int) -> dict:
     import numba
 
     _, mesh, pattern, sim = setup_once(n)
-    sim.mesh = mesh
     numba.set_num_threads(sim.threads)
     plain, cached = Fused(sim, cached=False), Fused(sim, cached=True)
     x = sim.x.copy()
-    for run, w in zip(sim._runs, sim.system.weights):
-        run.project(x, sim._targets, w)
-    reference = sim.system.rhs(sim._targets, np.zeros_like(sim._rhs)).copy()
-    sim._add_pin_terms(reference, x)
+    reference = np.zeros_like(sim._rhs)
+    project_and_gather(sim, x, reference)
     scale = np.abs(reference).max()
     errors = {}
     for name, f in (("fused", plain), ("fused_cached", cached)):

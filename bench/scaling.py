@@ -157,6 +157,33 @@ def setup_once(n: int):
     return t, mesh, pattern, sim
 
 
+def project_and_gather(sim, x, rhs) -> tuple[float, float]:
+    """The paper iteration's local step at ``x`` by its pieces: every group's
+    projection (numba element kernels), then the gather into ``rhs`` with the
+    anchor pin term. Returns (projection, gather) seconds."""
+    t0 = time.perf_counter()
+    for run, w in zip(sim._runs, sim.system.weights):
+        run.project(x, sim._targets, w)
+    t1 = time.perf_counter()
+    sim.system.rhs(sim._targets, rhs)
+    sim._add_pin_terms(rhs, x)
+    return t1 - t0, time.perf_counter() - t1
+
+
+def solve_and_take(sim, rhs, x):
+    """The paper iteration's global step: K⁻¹ ``rhs``, then the C-ordered copy and
+    the largest move from ``x`` (``system.take_solution``). Returns (new
+    positions, solve seconds, take seconds)."""
+    from foldcore.system import take_solution
+
+    t0 = time.perf_counter()
+    solution = sim.system.factor.solve(rhs)
+    t1 = time.perf_counter()
+    new_x = np.empty_like(x)
+    take_solution(solution, x, new_x)
+    return new_x, t1 - t0, time.perf_counter() - t1
+
+
 def one_round(sim) -> dict:
     """Time one step, one iteration by its pieces and one bare solve (seconds).
 
@@ -166,8 +193,6 @@ def one_round(sim) -> dict:
     """
     import numba
 
-    from foldcore.system import take_solution
-
     t = {}
     t0 = time.perf_counter()
     sim.step()
@@ -175,20 +200,9 @@ def one_round(sim) -> dict:
     # the paper iteration by pieces (what Simulation._paper_iteration does)
     numba.set_num_threads(sim.threads)
     x = sim.x
-    t0 = time.perf_counter()
-    for run, w in zip(sim._runs, sim.system.weights):
-        run.project(x, sim._targets, w)
-    t1 = time.perf_counter()
-    rhs = sim.system.rhs(sim._targets, sim._rhs)
-    sim._add_pin_terms(rhs, x)
-    t2 = time.perf_counter()
-    solution = sim.system.factor.solve(rhs)
-    t3 = time.perf_counter()
-    new_x = np.empty_like(x)
-    take_solution(solution, x, new_x)
-    t4 = time.perf_counter()
+    t["projection"], t["gather"] = project_and_gather(sim, x, sim._rhs)
+    new_x, t["solve"], t["take"] = solve_and_take(sim, sim._rhs, x)
     sim.x = new_x
-    t["projection"], t["gather"], t["solve"], t["take"] = t1 - t0, t2 - t1, t3 - t2, t4 - t3
     bare_rhs = np.asfortranarray(new_x)  # CHOLMOD's own layout, as the iteration's rhs
     t0 = time.perf_counter()
     sim.system.factor.solve(bare_rhs)
