@@ -689,6 +689,7 @@ def _hinge_group(pattern, points, strip_points, widths, ks, thickness, exact_arc
         params.append(np.tile(_hinge_params(widths[e] / k, thickness, target, k,
                                             sign[pattern.assignments[e]],
                                             pattern.max_angles[e], exact_arc), (k * m, 1)))
+        # per segment, as before: a vectorised norm sums differently (not bit-identical)
         lengths = np.array([float(np.linalg.norm(points[b] - points[a]))
                             for a, b in zip(grid[0, :-1], grid[0, 1:])])
         vols.append(np.repeat(widths[e] / k * lengths * thickness, k))
