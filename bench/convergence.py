@@ -157,7 +157,8 @@ def measure_scene(name, make, budget):
             "to_threshold": {f"{t:g}": first_below(points, t) for t in THRESHOLDS},
             "curve": points}
         rows[solver]["per_iteration_vs_bare_solve"] = per_it / result.timings_s["bare_solve"]
-        rows[solver]["rejected"] = getattr(sim._accelerated, "rejected", None)
+        rows[solver]["rejected"] = getattr(getattr(sim.strategy, "lbfgs", sim.strategy),
+                                          "rejected", None)
         print(f"{name:22s} {solver:8s} its {result.iterations:6d} "
               f"err {points[-1][2]:.3g}° time {statistics.median(totals):.3f} s", flush=True)
     return rows

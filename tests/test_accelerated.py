@@ -180,7 +180,7 @@ def test_hybrid_survives_an_interrupted_rigid_phase_and_keeps_given_positions():
 
     with pytest.raises(KeyboardInterrupt):
         sim.run(tolerance=1e-10, max_iterations=50, callback=interrupt)
-    assert sim._rigid is None and not sim._rigid_phase
+    assert sim.strategy.phase == "lbfgs" and sim.strategy.rigid is None
     done = sim.run(tolerance=1e-10, max_iterations=2_000)
     assert done.converged and abs(done.fold_angles_deg[0] - 90.0) <= 0.01
     again = Simulation(mesh, pattern, solver="hybrid")
@@ -190,7 +190,7 @@ def test_hybrid_survives_an_interrupted_rigid_phase_and_keeps_given_positions():
     in_rigid_phase = []
     Simulation(mesh, pattern, solver="hybrid").run(
         tolerance=1e-8, max_iterations=200,
-        callback=lambda s, moved: in_rigid_phase.append(s._rigid is not None))
+        callback=lambda s, moved: in_rigid_phase.append(s.strategy.phase == "rigid"))
     rigid_steps = sum(in_rigid_phase)
     assert 0 < rigid_steps < len(in_rigid_phase)
     exact = Simulation(mesh, pattern, solver="hybrid").run(tolerance=1e-8,

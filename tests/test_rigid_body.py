@@ -69,7 +69,7 @@ def test_jacobian_matches_finite_differences():
     sim = Simulation(mesh, pattern, solver="rigid")
     for _ in range(5):  # away from the flat state
         sim.step()
-    solver = sim._rigid
+    solver = sim.strategy.engine
     start = solver._state()
     jac, res = solver._jacobian(start)
     rng = np.random.default_rng(1)

@@ -12,10 +12,11 @@ import numpy as np
 
 import elements
 from elements.bending_hinge import FLOOR, TARGET, limit_excess
+from . import strategies
 from .errors import SimulationError
 from .measure import fold_angles
-from .strategies import DEFAULT_SOLVER, SOLVERS
-from .system import System, take_solution
+from .strategies import DEFAULT_SOLVER
+from .system import System
 from .threads import blas_on_one_thread
 
 ALPHA_UPDATE_EVERY = 10  # iterations between α-schedule updates (each costs a refactor)
@@ -25,8 +26,6 @@ STOP_LEAVE = 1e-3  # rad back inside its interval before a stop is released
 # 2-core Xeon, paper map, ms/iteration 1 vs 2 threads: Miura 2×2 (108 slots) 0.070 vs
 # 0.063 quiet / 2.3 with the cores busy; 5×5 (936) 0.41 vs 0.28; 10×10 (4 076) 1.77 vs 1.09.
 SERIAL_BELOW_SLOTS = 500
-HYBRID_RIGID_MAX = 200    # rigid-body steps at most per run of solver="hybrid"
-HYBRID_RIGID_TOL = 1e-10  # relative step below which its rigid phase ends (even at tolerance 0)
 BARE_SOLVE_REPEATS = 5  # solves timed for the per-iteration cost floor
 
 
@@ -127,23 +126,24 @@ class Simulation:
     mesh : ThickMesh
     pattern : CreasePattern
         The pattern the mesh was made from (targets, assignments, measurement).
-    solver : {"hybrid", "lbfgs", "paper", "anderson", "rigid"}
-        Iteration strategy, default ``"hybrid"`` (why:
-        :data:`foldcore.strategies.DEFAULT_SOLVER`): each ``run`` starts with
-        up to 200 ``"rigid"`` steps and continues with ``"lbfgs"`` from where
-        they stop (bare :meth:`step` calls are L-BFGS steps; a mesh the rigid
-        strategy cannot take runs L-BFGS alone). Its rigid phase reaches
-        position targets within a few iterations, before a ``decay`` < 1
-        (counted in iterations) has faded them: for a pull-and-release
-        schedule use ``"lbfgs"`` or ``"paper"``. ``energy_history`` joins
-        the rigid phase's energy and the paper's. ``"paper"``: the paper's plain local/global map
-        (every element a soft spring; iterations grow with panel length /
-        thickness). ``"anderson"``/``"lbfgs"``: the same local step and K,
-        accelerated (safeguarded Anderson; L-BFGS with K as initial Hessian,
-        :mod:`foldcore.accelerated`); their ``iterations`` are outer
-        iterations (a refused Anderson point or a line-search trial costs one
-        more local step inside the same iteration). ``"rigid"``: rigid panels
-        as rigid bodies, passive hinges bent as one arc whose angle is a bounded unknown, Levenberg–Marquardt
+    solver : {"hybrid", "lbfgs", "paper", "anderson", "rigid"} or a registered name
+        Iteration strategy (one module each in :mod:`foldcore.strategies`),
+        default ``"hybrid"`` (why: :data:`foldcore.strategies.DEFAULT_SOLVER`):
+        each ``run`` starts with up to 200 ``"rigid"`` steps and continues
+        with ``"lbfgs"`` from where they stop (bare :meth:`step` calls are
+        L-BFGS steps; a mesh the rigid strategy cannot take runs L-BFGS
+        alone). Its rigid phase reaches position targets within a few
+        iterations, before a ``decay`` < 1 (counted in iterations) has faded
+        them: for a pull-and-release schedule use ``"lbfgs"`` or ``"paper"``.
+        ``energy_history`` joins the rigid phase's energy and the paper's.
+        ``"paper"``: the paper's plain local/global map (every element a soft
+        spring; iterations grow with panel length / thickness).
+        ``"anderson"``/``"lbfgs"``: the same local step and K, accelerated
+        (safeguarded Anderson; L-BFGS with K as initial Hessian); their
+        ``iterations`` are outer iterations (a refused Anderson point or a
+        line-search trial costs one more local step inside the same
+        iteration). ``"rigid"``: rigid panels as rigid bodies, passive hinges
+        bent as one arc whose angle is a bounded unknown, Levenberg–Marquardt
         with geodesic acceleration (:mod:`foldcore.rigid_body`); needs a mesh
         of rigid panels and bending hinges. Its ``iterations`` are outer
         Levenberg–Marquardt iterations (rejected steps included) and its
@@ -186,8 +186,10 @@ class Simulation:
                  passive_floor_deg: float = 0.0, stop_stiffness: float = 1e3,
                  threads: int | None = None, strain_limits=None):
         start = time.perf_counter()
-        if solver not in SOLVERS:
-            raise SimulationError(f"unknown solver {solver!r} (available: {', '.join(SOLVERS)})")
+        try:
+            strategy = strategies.get(solver)
+        except KeyError as exc:
+            raise SimulationError(exc.args[0]) from None
         self.mesh, self.pattern, self.solver = mesh, pattern, solver
         self.x = mesh.rest_positions.copy()
         self._runs, offset = [], 0
@@ -217,15 +219,7 @@ class Simulation:
         self.length_scale = float(np.ptp(pattern.vertices, axis=0).max())
         self._monitor = self._failure_monitor(strain_limits)
         self._bare_solve = None  # (K version, seconds) of the last bare-solve timing
-        self._rigid = self._accelerated = None
-        self._rigid_phase = solver == "hybrid"  # next run() starts with rigid-body steps
-        if solver == "rigid":
-            from .rigid_body import RigidBodySolver
-            self._rigid = RigidBodySolver(self)
-            self.x = self._rigid.x
-        elif solver in ("anderson", "lbfgs", "hybrid"):
-            from .accelerated import AndersonSolver, LbfgsSolver
-            self._accelerated = (AndersonSolver if solver == "anderson" else LbfgsSolver)(self)
+        self.strategy = strategy(self)  # the one thing that moves self.x
 
     # ------------------------------------------------------------- actuation
     def set_fold_angles(self, angles) -> None:
@@ -336,13 +330,12 @@ class Simulation:
         if x.shape != self.x.shape or not np.isfinite(x).all():
             raise SimulationError(f"positions must be a finite ({self.mesh.n_vertices}, 3) "
                                   f"array of mm, got shape {x.shape}")
-        if self._rigid is not None:
-            raise SimulationError("solver 'rigid' keeps its panels rigid by construction: "
-                                  "its positions cannot be set")
-        self.x = np.ascontiguousarray(x.copy())
-        self._rigid_phase = False  # hybrid: continue from these positions with L-BFGS
-        if self._accelerated is not None:
-            self._accelerated.restart(self.x)
+        previous, self.x = self.x, np.ascontiguousarray(x.copy())
+        try:
+            self.strategy.positions_set()
+        except SimulationError:
+            self.x = previous
+            raise
 
     def nearest_vertex(self, point) -> int:
         """Id of the mesh vertex closest to a 3D point (mm), current positions."""
@@ -360,30 +353,13 @@ class Simulation:
 
     def _step(self) -> float:
         numba.set_num_threads(self.threads)
-        if self._rigid is not None:
-            energy, moved = self._rigid_iteration()
-        elif self._accelerated is not None:
-            energy, moved = self._accelerated.step()
-            self.x = self._accelerated.x
-        else:
-            energy, moved = self._paper_iteration()
+        energy, moved = self.strategy.step()
         self.energy_history.append(energy)
         self.iterations += 1
         if self._monitor is not None and self.solver == "paper":
             self._monitor.check(self.x, self.iterations, self._percent)
         self._advance_alpha()
         return moved
-
-    def _paper_iteration(self) -> tuple[float, float]:
-        """Local step (projections) then global solve; (energy before, largest move)."""
-        energy, rhs = self.local_step(self.x)
-        t0 = time.perf_counter()
-        solution = self.system.factor.solve(rhs)
-        new_x = np.empty(self.x.shape)
-        moved = float(take_solution(solution, self.x, new_x))
-        self.timings["solve"] += time.perf_counter() - t0
-        self.x = new_x
-        return energy, moved
 
     def local_step(self, x: np.ndarray) -> tuple[float, np.ndarray]:
         """Project every element at ``x`` and gather the right-hand side.
@@ -419,18 +395,6 @@ class Simulation:
         self.timings["solve"] += time.perf_counter() - t0
         return out
 
-    def _rigid_iteration(self) -> tuple[float, float]:
-        """One rigid-body step; assembly counts as projection time."""
-        t0, solve0 = time.perf_counter(), self._rigid.solve_time
-        energy, moved = self._rigid.step()
-        self.x = self._rigid.x
-        if self._hinges is not None:
-            self._hinges.state[:, 0] = self._rigid.phi
-        solve = self._rigid.solve_time - solve0
-        self.timings["solve"] += solve
-        self.timings["projection"] += time.perf_counter() - t0 - solve
-        return energy, moved
-
     def run(self, tolerance: float = 1e-8, max_iterations: int = 10_000, callback=None) -> Result:
         """Iterate until the largest step is ≤ ``tolerance`` × pattern size.
 
@@ -450,54 +414,29 @@ class Simulation:
         budget, limit = int(max_iterations), tolerance * self.length_scale
         moved, stopped = np.inf, False
         with blas_on_one_thread(self.threads > 1):
-            if self._rigid_phase and budget > 0:
-                used, moved, stopped = self._hybrid_rigid_phase(tolerance, budget, callback)
-                budget -= used
-            if budget > 0 and not stopped:
-                _, moved, stopped = self._iterate(budget, callback, limit)
+            self.strategy.begin_run()
+            try:
+                moved, stopped = self._iterate(budget, callback, limit)
+            finally:
+                self.strategy.end_run()
         self.timings["total"] += time.perf_counter() - start
         self.timings["bare_solve"] = self._bare_solve_floor()
         return self.result(not stopped and moved <= limit)
 
-    def _iterate(self, budget: int, callback, stop_at: float) -> tuple[int, float, bool]:
-        """Up to ``budget`` steps, until one moves ≤ ``stop_at`` mm or the callback says
-        stop; returns (steps taken, the last step's move in mm, whether the callback
-        stopped)."""
+    def _iterate(self, budget: int, callback, limit: float) -> tuple[float, bool]:
+        """Up to ``budget`` steps, until the strategy is settled (a step moved ≤
+        ``limit`` mm, :meth:`Strategy.settled`) or the callback says stop; returns
+        (the last step's move in mm, whether the callback stopped)."""
         moved = np.inf
-        for used in range(1, budget + 1):
+        for _ in range(budget):
             moved = self._step()
             if not np.isfinite(moved):
                 raise SimulationError("the iteration produced non-finite positions")
             if callback is not None and callback(self, moved) is False:
-                return used, moved, True
-            if moved <= stop_at:
-                return used, moved, False
-        return budget, moved, False
-
-    def _hybrid_rigid_phase(self, tolerance: float, budget: int,
-                            callback) -> tuple[int, float, bool]:
-        """``solver="hybrid"``: rigid-body Levenberg–Marquardt steps from the current
-        positions until they stop moving (≤ max(tolerance, HYBRID_RIGID_TOL) × size)
-        or HYBRID_RIGID_MAX steps, then L-BFGS continues from there on the paper's
-        energy. Returns :meth:`_iterate`'s (steps, last move, stopped). Meshes the
-        rigid strategy cannot take (elastic cells, other element types) go straight
-        to L-BFGS. Whatever ends the phase (an exception, an interrupt included),
-        the simulation is left in its L-BFGS phase."""
-        from .rigid_body import RigidBodySolver
-
-        self._rigid_phase = False
-        try:
-            self._rigid = RigidBodySolver(self)
-        except SimulationError:
-            return 0, np.inf, False
-        try:
-            self.x = self._rigid.x
-            return self._iterate(min(budget, HYBRID_RIGID_MAX), callback,
-                                 max(tolerance, HYBRID_RIGID_TOL) * self.length_scale)
-        finally:
-            self._rigid = None
-            self.x = np.ascontiguousarray(self.x.copy())
-            self._accelerated.restart(self.x)
+                return moved, True
+            if self.strategy.settled(moved, limit):
+                break
+        return moved, False
 
     def _bare_solve_floor(self) -> float:
         """:meth:`bare_solve_seconds`, timed once per factorisation of K (a sweep of
@@ -568,12 +507,8 @@ class Simulation:
 
     # --------------------------------------------------------------- private
     def _targets_changed(self) -> None:
-        """Targets moved: an accelerated strategy's history (energies, gradients) is stale;
-        ``hybrid`` starts its next run with rigid-body steps again."""
-        if self._accelerated is not None:
-            self._accelerated.restart(self.x)
-        if self.solver == "hybrid":
-            self._rigid_phase = True
+        """Targets moved: the strategy's history (energies, gradients) is stale."""
+        self.strategy.targets_changed()
 
     def _check_every_vertex_used(self) -> None:
         """A vertex in no element has no equation: K would be singular there."""

@@ -1,0 +1,88 @@
+"""``hybrid``: rigid-body steps first, then L-BFGS on the paper's energy (a composite).
+
+Each :meth:`Simulation.run` starts with a rigid phase (:mod:`.rigid`) from
+the current positions, until a step moves ≤ max(tolerance,
+``HYBRID_RIGID_TOL``) × size or ``HYBRID_RIGID_MAX`` steps were taken; then
+:mod:`.lbfgs` continues from where it stopped, so the run ends on the
+paper's own energy (Eq. 9 passive hinges, every element type). A mesh the
+rigid phase cannot take (elastic cells, other element types) runs L-BFGS
+alone. Bare :meth:`Simulation.step` calls outside a run are L-BFGS steps;
+whatever ends a rigid phase (its criterion, the budget, an exception or an
+interrupt), the strategy is left in its L-BFGS phase. Changed targets start
+the next run with a rigid phase again; positions set from outside are
+continued from with L-BFGS (a rigid phase would refit the panels).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import SimulationError
+from . import Strategy
+from .lbfgs import Lbfgs
+from .rigid import Rigid
+
+HYBRID_RIGID_MAX = 200    # rigid-body steps at most per run
+HYBRID_RIGID_TOL = 1e-10  # relative step below which the rigid phase ends (even at tolerance 0)
+
+
+class Hybrid(Strategy):
+    """``rigid`` for the first steps of each run, then ``lbfgs``."""
+
+    name = "hybrid"
+
+    def __init__(self, sim):
+        super().__init__(sim)
+        self.lbfgs = Lbfgs(sim)
+        self.rigid = None  # the rigid phase's strategy while it runs
+        self._rigid_steps = 0
+        self._pending = True  # the next run starts with a rigid phase
+
+    @property
+    def phase(self) -> str:
+        return "rigid" if self.rigid is not None else "lbfgs"
+
+    def begin_run(self) -> None:
+        if not self._pending:
+            return
+        self._pending = False
+        try:
+            self.rigid = Rigid(self.sim)
+        except SimulationError:
+            self.rigid = None  # not a rigid-panel mesh: L-BFGS alone
+        self._rigid_steps = 0
+
+    def step(self) -> tuple[float, float]:
+        if self.rigid is None:
+            return self.lbfgs.step()
+        self._rigid_steps += 1
+        return self.rigid.step()
+
+    def settled(self, moved: float, limit: float) -> bool:
+        if self.rigid is None:
+            return moved <= limit
+        floor = HYBRID_RIGID_TOL * self.sim.length_scale
+        if moved <= max(limit, floor) or self._rigid_steps >= HYBRID_RIGID_MAX:
+            self._leave_rigid_phase()
+        return False
+
+    def end_run(self) -> None:
+        self._leave_rigid_phase()
+
+    def _leave_rigid_phase(self) -> None:
+        if self.rigid is None:
+            return
+        self.rigid = None
+        self.sim.x = np.ascontiguousarray(self.sim.x.copy())
+        self.lbfgs.restart()
+
+    def targets_changed(self) -> None:
+        self.lbfgs.restart()
+        self._pending = True
+
+    def positions_set(self) -> None:
+        self._leave_rigid_phase()
+        self._pending = False
+        self.lbfgs.restart()
+
+    def restart(self) -> None:
+        self.lbfgs.restart()

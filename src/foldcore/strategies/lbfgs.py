@@ -1,0 +1,90 @@
+"""``lbfgs``: L-BFGS on the paper's energy with K as the initial Hessian.
+
+Liu, Bouaziz & Kavan 2017, "Quasi-Newton methods for real-time simulation of
+hyperelastic materials": the two-loop recursion with H₀ = K⁻¹ (one K solve
+per iteration) and an Armijo backtracking line search on E; when the search
+fails the plain step is taken and the history forgotten. Shared bookkeeping
+and the energy's gradient: :mod:`._accelerated`.
+"""
+from __future__ import annotations
+
+from collections import deque
+
+import numpy as np
+
+from ._accelerated import Accelerated
+
+LBFGS_MEMORY = 8  # (s, y) pairs kept
+ARMIJO = 1e-4  # sufficient-decrease constant of the line search
+BACKTRACKS = 4  # halvings before the line search gives up
+
+
+class Lbfgs(Accelerated):
+    """L-BFGS on E with K⁻¹ as initial inverse Hessian and Armijo backtracking.
+
+    ``step()`` returns (energy at the start point, largest move in mm).
+    """
+
+    name = "lbfgs"
+
+    def __init__(self, sim, memory: int = LBFGS_MEMORY):
+        self.memory = int(memory)
+        super().__init__(sim)
+
+    def _forget(self) -> None:
+        self._pairs = deque(maxlen=self.memory)
+        self._at = None  # (energy, ½∇E) already evaluated at self.x
+
+    def _evaluate(self, x: np.ndarray) -> tuple[float, np.ndarray]:
+        energy, rhs = self.sim.local_step(x)
+        return energy, self.sim.system.apply(x) - rhs  # ½∇E
+
+    def _advance(self) -> tuple[float, float]:
+        if self._at is None or self._k_changed():
+            self._at = self._evaluate(self.x)
+            self._k_changed()
+            self._pairs.clear()
+        energy, grad = self._at
+        direction = self._direction(grad)
+        slope = float(np.vdot(grad, direction))
+        if not slope < 0.0:  # not a descent direction: the plain step
+            self._pairs.clear()
+            direction = self._direction(grad)
+            slope = float(np.vdot(grad, direction))
+        x_new, at_new = self._line_search(energy, slope, direction)
+        if x_new is None:  # no sufficient decrease: the plain step, unchecked
+            self.rejected += 1
+            self._pairs.clear()
+            x_new = self.x + self._direction(grad)
+            at_new = self._evaluate(x_new)
+        s, y = x_new - self.x, at_new[1] - grad
+        if float(np.vdot(s, y)) > 1e-12 * float(np.vdot(s, s)) * self.sim.system.reference_weight:
+            self._pairs.append((s, y, 1.0 / float(np.vdot(s, y))))
+        moved = float(np.abs(s).max())
+        self.x, self._at = x_new, at_new
+        return energy, moved
+
+    def _direction(self, grad: np.ndarray) -> np.ndarray:
+        """−H grad by the two-loop recursion with H₀ = K⁻¹ (one K solve)."""
+        q = -grad
+        alphas = []
+        for s, y, rho in reversed(self._pairs):
+            a = rho * float(np.vdot(s, q))
+            q = q - a * y
+            alphas.append(a)
+        r = self.sim.global_step(q)
+        for (s, y, rho), a in zip(self._pairs, reversed(alphas)):
+            b = rho * float(np.vdot(y, r))
+            r = r + (a - b) * s
+        return r
+
+    def _line_search(self, energy, slope, direction):
+        """Armijo backtracking from step 1; (x, (energy, ½∇E)) or (None, None)."""
+        step = 1.0
+        for _ in range(BACKTRACKS + 1):
+            x = self.x + step * direction
+            at = self._evaluate(x)
+            if at[0] <= energy + 2.0 * ARMIJO * step * slope:
+                return x, at
+            step *= 0.5
+        return None, None

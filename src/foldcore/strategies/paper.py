@@ -1,0 +1,33 @@
+"""``paper``: the paper's local/global map (§3), x ← K⁻¹ b(x).
+
+Every element is projected at x (the local step, in parallel), the weighted
+targets are gathered into b(x), and the prefactored K gives the new
+positions (the global step). Monotone in the energy, but it moves a long
+panel only through its thin hinge faces, so its iteration count grows with
+(panel length / thickness)² (DESIGN.md, "Convergence").
+"""
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from ..system import take_solution
+from . import Strategy
+
+
+class PaperMap(Strategy):
+    """One local step then one global solve per :meth:`step`."""
+
+    name = "paper"
+
+    def step(self) -> tuple[float, float]:
+        sim = self.sim
+        energy, rhs = sim.local_step(sim.x)
+        t0 = time.perf_counter()
+        solution = sim.system.factor.solve(rhs)
+        new_x = np.empty(sim.x.shape)
+        moved = float(take_solution(solution, sim.x, new_x))
+        sim.timings["solve"] += time.perf_counter() - t0
+        sim.x = new_x
+        return energy, moved

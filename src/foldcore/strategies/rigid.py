@@ -1,0 +1,43 @@
+"""``rigid``: rigid panels as rigid bodies, Levenberg–Marquardt on the hinge energy.
+
+The engine is :class:`foldcore.rigid_body.RigidBodySolver` (unknowns, Jacobian,
+damping, geodesic acceleration); this module is the strategy around it: it
+steps the engine, hands its positions and strip angles to the Simulation and
+books the engine's assembly as projection time, its factorisations and
+solves as solve time. Needs a mesh of rigid panels and bending hinges.
+"""
+from __future__ import annotations
+
+import time
+
+from ..errors import SimulationError
+from . import Strategy
+
+
+class Rigid(Strategy):
+    """One Levenberg–Marquardt iteration per :meth:`step` (rejected steps count)."""
+
+    name = "rigid"
+
+    def __init__(self, sim):
+        from ..rigid_body import RigidBodySolver
+
+        super().__init__(sim)
+        self.engine = RigidBodySolver(sim)  # SimulationError on meshes it cannot take
+        sim.x = self.engine.x
+
+    def step(self) -> tuple[float, float]:
+        sim, engine = self.sim, self.engine
+        t0, solve0 = time.perf_counter(), engine.solve_time
+        energy, moved = engine.step()
+        sim.x = engine.x
+        if sim._hinges is not None:
+            sim._hinges.state[:, 0] = engine.phi
+        solve = engine.solve_time - solve0
+        sim.timings["solve"] += solve
+        sim.timings["projection"] += time.perf_counter() - t0 - solve
+        return energy, moved
+
+    def positions_set(self) -> None:
+        raise SimulationError("solver 'rigid' keeps its panels rigid by construction: "
+                              "its positions cannot be set")
