@@ -6,7 +6,9 @@ Units: mm, radians.
 """
 import numpy as np
 
-HINGE_PARAMS = ("width", "height", "target", "sign", "max_angle", "floor", "exact_arc")
+HINGE_PARAMS = ("width", "height", "target", "sign", "max_angle", "floor", "model", "strips",
+                "series")
+EQ8, ARC, AXIS = 0, 1, 2  # values of the "model" column
 
 
 def kabsch(p, t):
@@ -44,11 +46,11 @@ def strip_measures(x):
     return w_top, w_bot, h_p
 
 
-def estimate_angle(x, exact_arc):
-    """Eq. 9 with the trapezoid's perpendicular height; asin form for the arc."""
+def estimate_angle(x, arc_like):
+    """Eq. 9 with the trapezoid's perpendicular height; asin form for arcs."""
     w_top, w_bot, h_p = strip_measures(x)
     d = (w_bot - w_top) / 2
-    if exact_arc:
+    if arc_like:
         return 2 * np.arcsin(np.clip(d / h_p, -1.0, 1.0))
     h_perp = np.sqrt(max(h_p ** 2 - d ** 2, 0.0))
     if h_perp == 0.0:
@@ -70,21 +72,44 @@ def trapezoid(rest, width, phi):
     return out
 
 
-def arc(rest, width, phi):
-    """Points on the circular arc of the neutral axis, κ = φ/W (φ = 0: rest)."""
+def arc(rest, width, phi, length=None):
+    """Points on a circular arc of the neutral axis turning by φ over the width W,
+    of neutral-axis length ``length`` (default W), radius length/φ (φ = 0: rest)."""
     if phi == 0.0:
         return rest.copy()
-    k = phi / width
+    r = (width if length is None else length) / phi
     x, y, z = rest.T
-    # (1 − cos κx)/κ written as 2 sin²(κx/2)/κ: no cancellation for small κ
-    return np.column_stack([(1 / k - y) * np.sin(k * x),
-                            2 * np.sin(k * x / 2) ** 2 / k + y * np.cos(k * x), z])
+    psi = phi * x / width
+    # 1 − cos ψ written as 2 sin²(ψ/2): no cancellation for small ψ
+    return np.column_stack([(r - y) * np.sin(psi), 2 * r * np.sin(psi / 2) ** 2
+                            + y * np.cos(psi), z])
 
 
-def bent_target(rest, width, phi, exact_arc):
-    """The strip bent by φ (rad), centred, in its local frame."""
+def axis_length(width, height, phi, strips, theta=None):
+    """Neutral-axis length of an axis-true sub-strip: the chord W·cos(θ/2) of a
+    rotation by θ (default kφ) about the crease's mid-line, as an arc of angle θ
+    (length chord·(θ/2)/sin(θ/2)), per sub-strip; never below H|φ|/2 (inner
+    radius 0)."""
+    theta = strips * phi if theta is None else theta
+    chord = strips * width * np.cos(theta / 2)
+    length = chord if theta == 0 else chord * (theta / 2) / np.sin(theta / 2)
+    axis, pivot = length / strips, height * abs(phi) / 2
+    band = 0.05 * width  # the switch is rounded: a parabola tangent to both lines
+    if abs(axis - pivot) >= band:
+        return max(axis, pivot)
+    return (axis + pivot) / 2 + (axis - pivot) ** 2 / (4 * band) + band / 4
+
+
+def bent_target(rest, width, phi, model, height=None, strips=1, theta=None):
+    """The strip bent by φ (rad), centred, in its local frame (``model``: EQ8/ARC/AXIS;
+    ``theta``: its crease's bend, default kφ)."""
     rest = np.asarray(rest, float)
-    out = arc(rest, width, phi) if exact_arc else trapezoid(rest, width, phi)
+    if model == EQ8:
+        out = trapezoid(rest, width, phi)
+    elif model == ARC:
+        out = arc(rest, width, phi)
+    else:
+        out = arc(rest, width, phi, axis_length(width, height, phi, strips, theta))
     return out - out.mean(axis=0)
 
 
@@ -93,15 +118,18 @@ def hinge_angle(x_elem, params):
     p = dict(zip(HINGE_PARAMS, params))
     if not np.isnan(p["target"]):
         return float(p["target"])
-    phi = estimate_angle(x_elem, p["exact_arc"] > 0.5)
+    phi = estimate_angle(x_elem, p["model"] != EQ8)
     return clamp(phi, p["sign"], p["floor"], p["max_angle"])
 
 
-def bending_hinge(x_elem, rest, params):
-    """(out (8, 3), energy mm², angle rad) of one hinge sub-strip."""
+def bending_hinge(x_elem, rest, params, theta=None):
+    """(out (8, 3), energy mm², angle rad) of one hinge sub-strip; ``theta`` its
+    crease's bend (default: k × its own angle)."""
     x_elem = np.asarray(x_elem, float)
     phi = hinge_angle(x_elem, params)
-    target = bent_target(rest, params[0], phi, params[6] > 0.5)
+    p = dict(zip(HINGE_PARAMS, params))
+    target = bent_target(rest, p["width"], phi, int(p["model"]), p["height"], int(p["strips"]),
+                         theta)
     out, energy = fit(x_elem, target)
     return out, energy, phi
 
@@ -112,8 +140,8 @@ def _rigid_panel_element(x_elem, rest, params):
     return out, energy, ()
 
 
-def _bending_hinge_element(x_elem, rest, params):
-    out, energy, phi = bending_hinge(x_elem, rest, params)
+def bending_hinge_element(x_elem, rest, params, theta=None):
+    out, energy, phi = bending_hinge(x_elem, rest, params, theta)
     return out, energy, (phi,)
 
 
@@ -145,8 +173,22 @@ def _bar_element(x_elem, rest, params):
     return out, float(np.sum((p - out) ** 2)), ()
 
 
-NAIVE = {"rigid_panel": _rigid_panel_element, "bending_hinge": _bending_hinge_element,
+NAIVE = {"rigid_panel": _rigid_panel_element, "bending_hinge": bending_hinge_element,
          "stretch_hinge": _stretch_hinge_element, "bar": _bar_element}
+
+
+def crease_bends(x, group_like, params):
+    """(S,) each hinge strip's crease bend: k × its target when actuated, else the
+    sum of the angles of the k strips of its series (``series`` = its place)."""
+    ptr = group_like.indptr
+    phi = np.array([hinge_angle(np.asarray(x[group_like.indices[ptr[e]:ptr[e + 1]]], float),
+                                params[e]) for e in range(len(ptr) - 1)])
+    theta = np.empty_like(phi)
+    for e, row in enumerate(params):
+        p = dict(zip(HINGE_PARAMS, row))
+        k, first = int(p["strips"]), e - int(p["series"])
+        theta[e] = k * phi[e] if not np.isnan(p["target"]) else phi[first:first + k].sum()
+    return theta
 
 
 def project_group(etype_name, x, group_like, params=None):
@@ -168,11 +210,15 @@ def project_group(etype_name, x, group_like, params=None):
     element = NAIVE[etype_name]
     params = group_like.params if params is None else params
     ptr = group_like.indptr
+    # a hinge strip's target also depends on its crease's bend
+    extra = [(t,) for t in crease_bends(x, group_like, params)] \
+        if etype_name == "bending_hinge" else [()] * (len(ptr) - 1)
     out = np.zeros((len(group_like.indices), 3))
     energy = np.zeros(len(ptr) - 1)
     state = []
     for e in range(len(ptr) - 1):
         s = slice(ptr[e], ptr[e + 1])
-        out[s], energy[e], st = element(x[group_like.indices[s]], group_like.rest[s], params[e])
+        out[s], energy[e], st = element(x[group_like.indices[s]], group_like.rest[s], params[e],
+                                        *extra[e])
         state.append(st)
     return out, energy, np.array(state, dtype=float).reshape(len(energy), -1)

@@ -38,7 +38,8 @@ from foldcore.thickening import thicken
 sys.path.insert(0, str(Path(__file__).parent.parent / "examples" / "plugin_bar"))
 import bar as plugin_bar  # noqa: E402
 
-W, H, TARGET, SIGN, MAX_ANGLE, FLOOR, EXACT = range(7)
+W, H, TARGET, SIGN, MAX_ANGLE, FLOOR, MODEL, STRIPS, SERIES = range(9)
+EQ8, ARC, AXIS = naive.EQ8, naive.ARC, naive.AXIS
 TYPES = elements.available()
 KINDS = ("mesh", "soup")
 RTOL = 1e-12
@@ -47,22 +48,23 @@ RTOL = 1e-12
 # ------------------------------------------------------------------ scenes
 @functools.lru_cache(maxsize=None)
 def scenes() -> dict:
-    """Small realistic thick meshes: actuated / passive V, M, U; arc and Eq. 8."""
+    """Small realistic thick meshes: actuated / passive V, M, U; axis, arc and Eq. 8."""
     sh = patterns.single_hinge
     return {
-        "hinge_act_arc": thicken(sh(angle=90.0, width=4.0), 1.0, subdivisions=4),
+        "hinge_act_arc": thicken(sh(angle=90.0, width=4.0), 1.0, subdivisions=4, hinge="arc"),
+        "hinge_act_axis": thicken(sh(angle=150.0, width=1.5), 1.0, subdivisions=4),
         "hinge_act_M_eq8": thicken(sh(angle=-60.0, assignment="M", width=3.0), 1.0,
-                                   subdivisions=3, exact_arc=False),
+                                   subdivisions=3, hinge="eq8"),
         "hinge_V_arc": thicken(sh(assignment="V", width=2.0, max_angle=120.0), 0.5,
-                               subdivisions=2),
+                               subdivisions=2, hinge="arc"),
         "hinge_M_eq8": thicken(sh(assignment="M", width=2.0), 0.5, subdivisions=2,
-                               exact_arc=False),
-        "hinge_U_arc": thicken(sh(assignment="U", width=2.0), 0.5, subdivisions=3),
+                               hinge="eq8"),
+        "hinge_U_axis": thicken(sh(assignment="U", width=2.0), 0.5, subdivisions=3),
         "hinge_U_eq8": thicken(sh(assignment="U", width=2.0), 0.5, subdivisions=3,
-                               exact_arc=False),
-        "degree4_arc": thicken(patterns.degree4_vertex(rho1=40.0), 2.0),
+                               hinge="eq8"),
+        "degree4_axis": thicken(patterns.degree4_vertex(rho1=40.0), 2.0),
         "degree4_B_eq8": thicken(patterns.degree4_vertex(mode="B", rho1=-30.0), 2.0,
-                                 exact_arc=False),
+                                 hinge="eq8"),
         "hinge_stretch": thicken(sh(width=2.0), 1.0, stretch={0: 0.3}),
         "hinge_with_bars": _with_bars(thicken(sh(angle=90.0, width=4.0), 1.0,
                                               subdivisions=2)),
@@ -107,13 +109,24 @@ def _hinge_random(p, rng):
     p[:, SIGN] = rng.choice([-1.0, 0.0, 1.0], n)
     p[:, MAX_ANGLE] = rng.uniform(0.1, 1.5, n)
     p[:, FLOOR] = rng.uniform(0.0, 0.08, n)
-    p[:, EXACT] = rng.integers(0, 2, n)
+    p[:, MODEL] = rng.integers(0, 3, n)
     p[:, TARGET] = np.where(rng.random(n) < 0.3, rng.uniform(-1.5, 1.5, n), np.nan)
+    # soup strips stand alone: a passive one is its own series (k = 1); an actuated
+    # one's crease bends k × its target whatever its neighbours
+    p[:, STRIPS] = np.where(np.isnan(p[:, TARGET]), 1, rng.integers(1, 9, n))
+    p[:, SERIES] = 0
+    # a constant-length arc turns its inner face inside out past 2W/H (its radius
+    # W/φ < H/2): keep arc strips inside the range their shape exists in
+    arc = p[:, MODEL] == ARC
+    reach = 0.95 * 2.0 * p[:, W] / p[:, H]
+    p[arc, MAX_ANGLE] = np.minimum(p[arc, MAX_ANGLE], reach[arc])
+    p[arc, TARGET] = np.clip(p[arc, TARGET], -reach[arc], reach[arc])
     return p
 
 
 def _hinge_bent(rest, params, rng):
-    return naive.bent_target(rest, params[W], rng.uniform(-2.6, 2.6), params[EXACT] > 0.5)
+    return naive.bent_target(rest, params[W], rng.uniform(-2.6, 2.6), int(params[MODEL]),
+                             params[H], int(params[STRIPS]))
 
 
 def _stretch_rest(p, rng=None):
@@ -338,7 +351,7 @@ def test_twin_states_cover_the_clamps():
                    np.random.default_rng(0))
     passive = np.isnan(p[:, TARGET])
     est = np.array([naive.estimate_angle(x[g.indices[g.indptr[e]:g.indptr[e + 1]]],
-                                         p[e, EXACT] > 0.5) for e in range(len(p))])
+                                         p[e, MODEL] != EQ8) for e in range(len(p))])
     wrong_side = passive & (p[:, SIGN] * est < 0)
     too_far = passive & (np.abs(est) > p[:, MAX_ANGLE])
     assert len(p) >= 300 and wrong_side.sum() >= 20 and too_far.sum() >= 20
@@ -396,9 +409,9 @@ def _strip(width=1.0, height=0.8, length=5.0):
     return np.array(top + [(a, -y, c) for a, _, c in top])
 
 
-def _project_strip(rest, phi, exact, x=None, passive=False):
-    params = np.array([[1.0, 0.8, np.nan if passive else phi, 0.0, math.pi, 0.0,
-                        float(exact)]])
+def _project_strip(rest, phi, model, x=None, passive=False, strips=1, height=0.8):
+    params = np.array([[1.0, height, np.nan if passive else phi, 0.0, math.pi, 0.0,
+                        float(model), float(strips), 0.0]])
     g = SimpleNamespace(indptr=np.array([0, 8], dtype=np.int64),
                         indices=np.arange(8, dtype=np.int64), rest=rest)
     return run("bending_hinge", rest if x is None else x, g, params)
@@ -412,7 +425,7 @@ def _d(p, i, j):
 def test_exact_arc_target_is_a_circular_bend(phi):
     rest = _strip()
     width, height = 1.0, 0.8
-    out, _, state = _project_strip(rest, phi, exact=True)
+    out, _, state = _project_strip(rest, phi, ARC)
     radius = width / phi
     assert state[0, 0] == phi
     for i, j in ((0, 1), (3, 2)):
@@ -429,7 +442,7 @@ def test_exact_arc_target_is_a_circular_bend(phi):
     assert np.allclose(centres[3], centres[2], rtol=0, atol=1e-12 * abs(radius))
     # its own estimate (asin) returns φ, so a passive arc strip is a fixed point
     assert naive.estimate_angle(out, True) == pytest.approx(phi, abs=1e-12)
-    assert _project_strip(rest, 0.0, True, x=out, passive=True)[2][0, 0] == pytest.approx(
+    assert _project_strip(rest, 0.0, ARC, x=out, passive=True)[2][0, 0] == pytest.approx(
         phi, abs=1e-12)
 
 
@@ -438,18 +451,79 @@ def test_eq8_target_is_inverted_by_eq9(phi):
     """Within one strip's limit 2·atan(W/H) (1.79 rad here) the top face stays positive."""
     rest = _strip()
     height = 0.8
-    out, _, _ = _project_strip(rest, phi, exact=False)
+    out, _, _ = _project_strip(rest, phi, EQ8)
     w_top, w_bot, _ = naive.strip_measures(out)
     assert w_bot - w_top == pytest.approx(2 * height * math.tan(phi / 2), abs=1e-12)
     assert naive.estimate_angle(out, False) == pytest.approx(phi, abs=1e-12)
-    kernel_phi = _project_strip(rest, 0.0, False, x=out, passive=True)[2][0, 0]
+    kernel_phi = _project_strip(rest, 0.0, EQ8, x=out, passive=True)[2][0, 0]
     assert kernel_phi == pytest.approx(phi, abs=1e-12)
+
+
+def _end_face_frame(face):
+    """(origin, across-thickness unit vector) of an end face's 4 vertices in the
+    cross-section plane (x, y): the neutral-axis point and the face direction."""
+    mid = face.mean(axis=0)
+    up = face[:2].mean(axis=0) - face[2:].mean(axis=0)  # top pair minus bottom pair
+    return mid[:2], up[:2] / np.linalg.norm(up[:2])
+
+
+@pytest.mark.parametrize("strips", [1, 2, 4])
+@pytest.mark.parametrize("theta", [-2.2, -1.0, 0.4, 1.2, 2.0])
+def test_axis_hinge_turns_the_end_faces_about_the_crease_mid_line(theta, strips):
+    """k axis sub-strips, each bent θ/k, chained end face to end face: the crease's
+    last face is its first turned by θ about the crease's mid-line (the defining
+    property, checked on the kernel's own targets). θ below θ* = 2·atan(W/H):
+    W = k·1 = 1…4 mm, H = 0.2 mm."""
+    height, width = 0.2, 1.0
+    rest = _strip(width=width, height=height)
+    phi = theta / strips
+    out, _, _ = _project_strip(rest, phi, AXIS, strips=strips, height=height)
+    left, right = [0, 3, 4, 7], [1, 2, 5, 6]
+    o_l, u_l = _end_face_frame(out[left])
+    o_r, _ = _end_face_frame(out[right])
+    tilt = math.atan2(-u_l[0], u_l[1])  # the target's left face: up = R(tilt)·ŷ
+
+    def rotation(a):
+        return np.array([[math.cos(a), -math.sin(a)], [math.sin(a), math.cos(a)]])
+
+    # chain the k strips from the crease's first face, x = −W/2 turned by −θ/2
+    turn = -theta / 2
+    origin = rotation(turn) @ np.array([-strips * width / 2, 0.0])
+    for _ in range(strips):
+        origin = origin + rotation(turn - tilt) @ (o_r - o_l)
+        turn += phi
+    # rigid origami: the last face is x = W/2 of the flat strip turned by θ/2 about 0
+    expected = strips * width / 2 * np.array([math.cos(theta / 2), math.sin(theta / 2)])
+    np.testing.assert_allclose(origin, expected, atol=1e-12)
+    # and the estimate inverts it (passive axis strips are fixed points)
+    assert _project_strip(rest, 0.0, AXIS, x=out, passive=True, strips=strips,
+                          height=height)[2][0, 0] == pytest.approx(phi, abs=1e-12)
+
+
+@pytest.mark.parametrize("phi", [1.9, 2.5, -3.0])
+def test_axis_hinge_past_its_pivot_angle_keeps_a_zero_inner_radius(phi):
+    """Past θ* = 2·atan(W/H) (W = 1, H = 0.8: 1.79 rad) the neutral axis stays at
+    H|φ|/2: the inner face has zero length (radius 0), the end faces length H."""
+    rest = _strip()
+    out, _, _ = _project_strip(rest, phi, AXIS)
+    inner = (0, 1) if phi > 0 else (4, 5)
+    assert _d(out, *inner) == pytest.approx(0.0, abs=1e-12)
+    assert _d(out, 0, 4) == pytest.approx(0.8, rel=1e-12)
+
+
+def test_pivot_blend_is_one_constant_on_both_sides_of_the_layering():
+    """elements cannot import foldcore, foldcore.hinges must not import numba: the
+    rounding band of the axis hinge's switch is written twice and kept equal here."""
+    from elements.bending_hinge import PIVOT_BLEND as kernel_band
+    from foldcore.hinges import PIVOT_BLEND as model_band
+
+    assert kernel_band == model_band
 
 
 def test_bend_is_continuous_at_zero():
     rest = _strip()
-    for exact in (False, True):
-        out, energy, _ = _project_strip(rest, 1e-13, exact)
+    for model in (EQ8, ARC, AXIS):
+        out, energy, _ = _project_strip(rest, 1e-13, model, strips=4)
         assert np.allclose(out, rest, rtol=0, atol=1e-12) and energy[0] < 1e-24
 
 

@@ -27,6 +27,7 @@ import pytest
 import folded
 from folded import scene
 from foldcore import patterns
+from foldcore.strain import neutral_lengths
 from foldcore.cli import main
 from foldcore.errors import PatternError
 from foldcore.fabrication import (ExportError, atomic_path, read_result, sheet_outlines,
@@ -78,7 +79,10 @@ def test_folded_hinge_stl_volume_is_panels_plus_chord_trapezoids(tmp_path):
     _check_closed_and_oriented(solid.faces)
     hinges = mesh.groups["bending_hinge"]
     phi = np.radians(np.abs(result.strip_angles_deg))
-    expected = mesh.groups["rigid_panel"].volumes.sum() + (hinges.volumes * np.sinc(
+    # a strip's planar-faced prism: cross-section ℓ·H·sin(φ)/φ for a neutral axis ℓ
+    # (the axis hinge shortens it to ℓ < w as it bends, the arc keeps ℓ = w)
+    shorter = neutral_lengths(hinges.params, phi) / hinges.params[:, 0]
+    expected = mesh.groups["rigid_panel"].volumes.sum() + (hinges.volumes * shorter * np.sinc(
         phi / np.pi)).sum()
     assert solid.volume == pytest.approx(expected, rel=1e-6)
 
@@ -91,10 +95,12 @@ def test_folded_vertex_stl_keeps_the_panel_volume(tmp_path):
     assert solid.is_watertight and solid.is_winding_consistent
     _check_closed_and_oriented(solid.faces)
     panels = mesh.groups["rigid_panel"].volumes.sum()
-    hinges = mesh.groups["bending_hinge"].volumes.sum()
-    phi = np.radians(np.abs(strip_bend_angles(mesh, result.positions)).max())
+    strips = mesh.groups["bending_hinge"]
+    phi = np.radians(np.abs(strip_bend_angles(mesh, result.positions)))
+    shortest = (neutral_lengths(strips.params, phi) / strips.params[:, 0]).min()  # axis hinges
     tol = 1e-6 * mesh.volume()
-    assert panels + hinges * np.sinc(phi / np.pi) - tol <= solid.volume <= mesh.volume() + tol
+    assert panels + strips.volumes.sum() * shortest * np.sinc(phi.max() / np.pi) - tol \
+        <= solid.volume <= mesh.volume() + tol
 
 
 def test_stl_header_is_binary_and_refuses_bad_positions():

@@ -106,6 +106,30 @@ def test_result_file_keeps_targets(tmp_path):
     assert_same(p, fio.read_fold(tmp_path / "r.fold"))
 
 
+def test_hinge_models_read_and_travel_with_results(tmp_path):
+    """foldcore:edges_hinge is read per edge (null = default) and written into
+    result files, so render/export rebuild the mesh with the models simulated."""
+    from foldcore.fabrication import read_result
+    from foldcore.outputs import write_result
+    from foldcore.simulation import Simulation
+    from foldcore.thickening import thicken
+
+    pattern = four_squares()
+    path = write_json(tmp_path / "p.fold", fold_json(
+        pattern, **{"foldcore:edges_hinge": [None] * 8 + ["arc", None, "eq8", "axis"]}))
+    fold = fio.read_fold_file(path)
+    assert fold.hinge == [None] * 8 + ["arc", None, "eq8", "axis"]
+    mesh = thicken(fold.pattern, 1.0, hinge=fold.hinge)
+    assert list(mesh.hinge_model[8:]) == ["arc", "axis", "eq8", "axis"]
+    result = Simulation(mesh, fold.pattern, solver="rigid").run(max_iterations=3)
+    write_result(result, fold.pattern, mesh, 1.0, {}, fold=tmp_path / "r.fold")
+    stored = json.loads((tmp_path / "r.fold").read_text())["foldcore:edges_hinge"]
+    assert stored == [None] * 8 + ["arc", "axis", "eq8", "axis"]
+    rebuilt = read_result(tmp_path / "r.fold").mesh
+    np.testing.assert_array_equal(rebuilt.groups["bending_hinge"].params,
+                                  mesh.groups["bending_hinge"].params)
+
+
 def test_mesh_edges_numbering():
     faces = [np.array([0, 1, 4, 5]), np.array([1, 2, 3, 4])]
     assert fio.mesh_edges(faces).tolist() == [[0, 1], [1, 4], [4, 5], [5, 0],
@@ -216,6 +240,9 @@ BAD_FOLDS = {  # name: (file text, substrings the message must contain)
                ["edges_foldAngle", "3 entries", "7 edges"]),
     "string": (json.dumps(_mutate(fold_json(two_squares()), "foldcore:edges_width", 6, "2")),
                ["foldcore:edges_width[6]"]),
+    "hinge": (json.dumps(fold_json(two_squares(), **{"foldcore:edges_hinge": [None] * 6
+                                                      + ["rigid"]})),
+              ["foldcore:edges_hinge[6]", "edge 6", "'axis'"]),
     "toplevel": ("[1, 2]", ["JSON object"]),
     "missing": ('{"vertices_coords": []}', ["edges_vertices"]),
 }

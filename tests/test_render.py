@@ -106,12 +106,13 @@ def test_valley_only_scene_has_no_mountain_colour():
 
 def test_scalar_colouring_with_colour_bar(tmp_path):
     pattern, mesh, result = scene("d4")
-    coloured = render_image(pattern, mesh, result.positions, size=SIZE,
+    # the front view: the mountain crease (−45°, its strips −11.25°) faces the camera
+    coloured = render_image(pattern, mesh, result.positions, size=SIZE, view="front",
                             scalars=result.strip_angles_deg, scalar_name="strip bend (deg)")
     bar = coloured[int(0.8 * SIZE[1]):]           # bottom strip: the colour bar, alone
     assert _red(bar).sum() > 300 and _blue(bar).sum() > 300     # the map's two ends
     assert (bar < 80).all(axis=-1).sum() > 30                   # its dark label text
-    # signed angles, diverging map: valleys blue, the mountain (−10°: pale) red
+    # signed angles, diverging map: valleys blue, the mountain red
     solid = coloured[: int(0.8 * SIZE[1])].astype(int)
     assert _blue(solid).sum() > 100
     assert ((solid[..., 0] > solid[..., 2] + 30) & (solid[..., 0] > solid[..., 1] + 15)).sum() > 10

@@ -25,25 +25,29 @@ from foldcore.thickening import thicken
 H, W, K = 1.0, 2.0, 4  # mm, mm, sub-strips
 
 
-def hinge(angle: float, exact_arc: bool, assignment: str = "V"):
+def hinge(angle: float, model: str, assignment: str = "V"):
     pattern = patterns.single_hinge(panel_length=5 * H, depth=10.0, angle=angle, width=W,
                                     assignment=assignment)
-    return pattern, thicken(pattern, H, subdivisions=K, exact_arc=exact_arc)
+    return pattern, thicken(pattern, H, subdivisions=K, hinge=model)
 
 
-@pytest.mark.parametrize("exact_arc", [True, False])
+@pytest.mark.parametrize("model", ["axis", "arc", "eq8"])
 @pytest.mark.parametrize("angle", [60.0, -120.0])
-def test_actuated_hinge_strain_matches_the_closed_form(exact_arc, angle):
-    pattern, mesh = hinge(angle, exact_arc, "V" if angle > 0 else "M")
+def test_actuated_hinge_strain_matches_the_closed_form(model, angle):
+    """Below θ* = 2·atan(W/H) = 126.9° the axis hinge's neutral axis is W·f(θ),
+    f(θ) = (θ/2)/tan(θ/2): both faces also shorten by 1 − f."""
+    pattern, mesh = hinge(angle, model, "V" if angle > 0 else "M")
     result = Simulation(mesh, pattern, solver="rigid").run(tolerance=1e-10, max_iterations=50)
     phi, ratio = np.radians(angle) / K, H / (W / K)
-    bottom = 0.5 * phi * ratio if exact_arc else ratio * np.tan(0.5 * phi)
-    # exact arcs are compatible: to the stopping tolerance; Eq. 8 trapezoids are not
+    bend = ratio * np.tan(0.5 * phi) if model == "eq8" else 0.5 * phi * ratio
+    theta = K * phi
+    axial = (theta / 2) / np.tan(theta / 2) - 1.0 if model == "axis" else 0.0
+    # arcs are compatible: to the stopping tolerance; Eq. 8 trapezoids are not
     # (slanted end faces against a panel's square one): their outer sub-strips settle
     # O(φ²) away, bounded by (φ/2)² relative
-    rtol = 1e-6 if exact_arc else (0.5 * phi) ** 2
-    np.testing.assert_allclose(result.strip_strains[:, 1], bottom, rtol=rtol)
-    np.testing.assert_allclose(result.strip_strains[:, 0], -bottom, rtol=rtol)
+    rtol = (0.5 * phi) ** 2 if model == "eq8" else 1e-6
+    np.testing.assert_allclose(result.strip_strains[:, 1], axial + bend, rtol=rtol)
+    np.testing.assert_allclose(result.strip_strains[:, 0], axial - bend, rtol=rtol)
 
 
 THETA_F = 45.0  # degrees: the first-failure angle the limits below are chosen for
@@ -61,7 +65,7 @@ def test_first_failure_angle_matches_eq8(assignment, side):
     the first failure is at θ_f to 0.1°."""
     limit = eq8_limit(THETA_F)
     sign = 1.0 if assignment == "V" else -1.0
-    pattern, mesh = hinge(sign * 90.0, exact_arc=False, assignment=assignment)
+    pattern, mesh = hinge(sign * 90.0, model="eq8", assignment=assignment)
     limits = StrainLimits(**{side: limit})
     sim = Simulation(mesh, pattern, solver="paper", strain_limits=limits)
     result = sim.run(tolerance=0, max_iterations=20_000,
@@ -77,7 +81,7 @@ def test_accelerated_strategy_finds_the_first_failure_by_a_fold_percent_sweep():
     a sweep of the target in 1 % steps of 90° finds θ_f within one step (0.9°) plus
     the converged hinge's own error (< 0.1°, either side: the 50 % step's target
     is θ_f itself, so the reported mean angle is θ_f ± that error)."""
-    pattern, mesh = hinge(90.0, exact_arc=False, assignment="V")
+    pattern, mesh = hinge(90.0, model="eq8", assignment="V")
     sim = Simulation(mesh, pattern, solver="lbfgs",
                      strain_limits=StrainLimits(tension=eq8_limit(THETA_F)))
     for percent in range(0, 101):
@@ -91,7 +95,7 @@ def test_accelerated_strategy_finds_the_first_failure_by_a_fold_percent_sweep():
 
 
 def test_no_failure_below_the_limits_and_report_lists_strains():
-    pattern, mesh = hinge(30.0, exact_arc=True)
+    pattern, mesh = hinge(30.0, model="arc")
     limits = StrainLimits(tension=1.0, compression=1.0)  # far above (H/W)·θ/2 = 0.26
     result = Simulation(mesh, pattern, solver="rigid", strain_limits=limits).run(
         tolerance=1e-10, max_iterations=50)
@@ -103,7 +107,7 @@ def test_no_failure_below_the_limits_and_report_lists_strains():
 @pytest.mark.parametrize("bad", [StrainLimits(tension=0.0), StrainLimits(compression=-1),
                                  StrainLimits(tension=np.nan), (0.1, 0.1)])
 def test_bad_limits_are_refused(bad):
-    pattern, mesh = hinge(30.0, exact_arc=True)
+    pattern, mesh = hinge(30.0, model="arc")
     with pytest.raises(SimulationError, match="strain"):
         Simulation(mesh, pattern, strain_limits=bad)
 
@@ -124,7 +128,7 @@ def test_accelerated_strategy_checks_limits_when_a_result_is_taken_after_bare_st
     """step() alone does not check (an lbfgs iterate is not a physical state); the
     state is checked when its result is taken: a hinge driven to 90° against a
     limit that fails at 45° is reported once the result is read."""
-    pattern, mesh = hinge(90.0, exact_arc=False, assignment="V")
+    pattern, mesh = hinge(90.0, model="eq8", assignment="V")
     sim = Simulation(mesh, pattern, solver="lbfgs",
                      strain_limits=StrainLimits(tension=eq8_limit(THETA_F)))
     for _ in range(300):

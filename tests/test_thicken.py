@@ -619,7 +619,7 @@ def reference_k(W, H, theta_deg, cap=16):
 ])
 def test_auto_subdivisions_rule(W, H, theta, want):
     assert reference_k(W, H, theta) == want
-    assert int(auto_subdivisions(W, H, theta)[0]) == want
+    assert int(auto_subdivisions(W, H, theta, hinge="eq8")[0]) == want
     # the chosen k is the smallest that lets every sub-strip reach θmax/k
     t = math.radians(theta)
     assert t / want <= 2 * math.atan(W / (want * H))
@@ -630,13 +630,13 @@ def test_auto_subdivisions_rule(W, H, theta, want):
 @given(W=st.floats(0.05, 20), H=st.floats(0.05, 5), theta=st.floats(1.0, 180.0))
 @FAST
 def test_auto_subdivisions_matches_reference(W, H, theta):
-    assert int(auto_subdivisions(W, H, theta)[0]) == reference_k(W, H, theta)
+    assert int(auto_subdivisions(W, H, theta, hinge="eq8")[0]) == reference_k(W, H, theta)
 
 
 def test_auto_subdivisions_in_mesh():
     pattern = patterns.degree4_vertex(widths=[16.0, 1.6, 4.0, 2.0]).replace(
         max_angles=[180.0, 180.0, 100.0, 30.0] + [180.0] * 6)
-    mesh = thicken(pattern, 1.0, subdivisions="auto", exact_arc=False)
+    mesh = thicken(pattern, 1.0, subdivisions="auto", hinge="eq8")
     want = [reference_k(w, 1.0, t) for w, t in zip([16.0, 1.6, 4.0, 2.0],
                                                    [180.0, 180.0, 100.0, 30.0])]
     assert want == [4, 7, 3, 2]
@@ -648,17 +648,36 @@ def test_auto_width_with_auto_subdivisions_eq8_hits_the_cap():
     # Eq. 7 with r = 0 gives W = Hθ/2; then θ/k > 2 atan(θ/(2k)) for every k, so the
     # Eq. 8 rule can never be satisfied and k stops at its cap (16).
     pattern = patterns.single_hinge()
-    mesh = thicken(pattern, 1.0, exact_arc=False)
+    mesh = thicken(pattern, 1.0, hinge="eq8")
     assert mesh.subdivisions[0] == 16
     check_mesh(pattern, mesh, 1.0)
 
 
-def test_auto_subdivisions_exact_arc_uses_the_smoothness_rule_only():
-    # the arc reaches 2W/H = θmax at W = Hθ/2 for any k: k = ceil(180/45) = 4
+def test_auto_subdivisions_of_arcs_use_the_smoothness_rule_only():
+    # the arc reaches 2W/H = θmax at W = Hθ/2 for any k, the axis hinge pivots past
+    # 2·atan(W/H): k = ceil(180/45) = 4 for both, Eq. 8 per hinge only where asked
     pattern = patterns.single_hinge()
-    mesh = thicken(pattern, 1.0)
-    assert mesh.subdivisions[0] == 4
-    assert int(auto_subdivisions(0.2, 1.0, 30.0, exact_arc=True)[0]) == 2
+    for model in ("arc", "axis", None):
+        assert thicken(pattern, 1.0, hinge=model).subdivisions[0] == 4
+    assert int(auto_subdivisions(0.2, 1.0, 30.0, hinge="arc")[0]) == 2
+    mixed = auto_subdivisions([0.2, 0.2], 1.0, 30.0, hinge=["axis", "eq8"])
+    assert mixed[0] == 2 and mixed[1] > 2
+
+
+def test_hinge_models_per_edge_reach_the_kernel_and_bad_names_are_refused():
+    from elements.bending_hinge import AXIS, EQ8, MODEL, STRIPS
+
+    pattern = patterns.degree4_vertex()
+    models = ["eq8", None, "axis", "arc"] + [None] * (pattern.n_edges - 4)
+    mesh = thicken(pattern, 2.0, hinge=models)
+    assert list(mesh.hinge_model[:4]) == ["eq8", "axis", "axis", "arc"]
+    assert (mesh.hinge_model[4:] == "").all()
+    g = mesh.groups["bending_hinge"]
+    codes = {e: set(g.params[g.source == e, MODEL]) for e in range(4)}
+    assert codes == {0: {EQ8}, 1: {AXIS}, 2: {AXIS}, 3: {1.0}}
+    np.testing.assert_array_equal(g.params[:, STRIPS], mesh.subdivisions[g.source])
+    with pytest.raises(MeshError, match="edge 2: unknown hinge model 'hinged'"):
+        thicken(pattern, 2.0, hinge=["axis", "arc", "hinged"] + [None] * (pattern.n_edges - 3))
 
 
 # ====================================================================== errors

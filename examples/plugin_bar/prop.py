@@ -4,7 +4,10 @@ One hinge (panels 20 mm, H = 1 mm, W = 2 mm, k = 4) is actuated to 90°; a bar
 joins the far top edges of its two panels with the length they have when
 the hinge is folded to 60° (geometry below). The bar is stiff (weight 100×
 the hinge's), so the hinge stops near 60°, not 90°: the angle printed is
-where the bar's and the hinge's springs balance. ``bar.py`` defines the
+where the bar's and the hinge's springs balance — 58.79° with the default
+axis hinge, whose strips, held short of 90°, still shorten toward their 90°
+length and draw the panels together (60.11° with ``hinge="arc"``, whose
+strips keep their length; measured). ``bar.py`` defines the
 element type; nothing in foldcore is edited.
 
     python examples/plugin_bar/prop.py [OUT_DIR]   # writes prop.fold / prop.json
@@ -19,6 +22,7 @@ from bar import bar_group  # noqa: E402  (defining Bar registers the type)
 
 import elements  # noqa: E402
 from foldcore import patterns  # noqa: E402
+from foldcore.hinges import DEFAULT_HINGE, neutral_length  # noqa: E402
 from foldcore.outputs import write_result  # noqa: E402
 from foldcore.simulation import Simulation  # noqa: E402
 from foldcore.thickening import thicken  # noqa: E402
@@ -30,13 +34,14 @@ TARGET, PROP = 90.0, 60.0  # degrees: hinge target, angle at which the bar is at
 def far_edge_distance(angle_deg: float) -> float:
     """Distance (mm) between the panels' far top edges at fold angle ``angle_deg`` (valley).
 
-    The hinge's neutral surface is an arc of length W and angle φ (exact-arc
-    target): its chord is c = 2(W/φ)·sin(φ/2), and each panel leaves a chord
-    end at φ/2 to it. A far top edge lies ℓ = PANEL − W/2 along its panel and
+    The hinge's neutral surface is an arc of angle φ and the length L its model
+    gives it (:func:`foldcore.hinges.neutral_length`: W·(φ/2)/tan(φ/2) for the
+    default axis hinge, W for the arc): its chord is c = 2(L/φ)·sin(φ/2), and
+    each panel leaves a chord end at φ/2 to it. A far top edge lies ℓ = PANEL − W/2 along its panel and
     H/2 toward the fold's inside, so the distance is c + 2ℓ·cos(φ/2) − H·sin(φ/2).
     """
     phi = np.radians(angle_deg)
-    chord = 2 * (W / phi) * np.sin(phi / 2)
+    chord = 2 * (float(neutral_length(DEFAULT_HINGE, W, H, phi)) / phi) * np.sin(phi / 2)
     return chord + 2 * (PANEL - W / 2) * np.cos(phi / 2) - H * np.sin(phi / 2)
 
 

@@ -17,16 +17,23 @@ Parameters (columns of ``params``, angles per sub-strip in radians):
   their sign's side, §4.2);
 * ``max_angle`` largest |φ| (§4.3); ``floor`` smallest |φ| a passive M/V strip
   is given when its estimate has the wrong sign;
-* ``exact_arc`` 1: target on the circular arc of the neutral axis (exact
-  bending), 0: Eq. 8's trapezoid (end faces sheared, error O(φ²)).
+* ``model``: ``AXIS`` (2) arc whose neutral axis shortens so the panels turn
+  about the crease's mid-line (:func:`axis_length`), ``ARC`` (1) circular
+  arc of constant neutral-axis length (the paper's), ``EQ8`` (0) Eq. 8's
+  trapezoid (end faces sheared, error O(φ²)); why: :mod:`foldcore.hinges`;
+* ``strips`` k, sub-strips in series across the crease, and ``series`` this
+  strip's place among them (0 … k−1; the k are consecutive elements): the
+  axis model shortens each strip for its crease's total bend θ, the sum of
+  the k strips' angles (:func:`series_bend`).
 
 A passive strip's angle is estimated from its current shape by Eq. 9,
 θ = 2·atan((W_b − W_t) / (2 H_p)), with H_p the *perpendicular* height
 √(s² − ((W_b − W_t)/2)²) recovered from the mean end-face length s (the end
 faces of an Eq. 8 trapezoid are slanted, s = H / cos(θ/2); the paper's H_p = s
 would return 2·atan(sin(θ/2)) instead of θ). Equivalently θ = 2·asin((W_b − W_t)
-/ (2s)), which also inverts the exact arc (radial end faces, s = H), so both
-targets are fixed points of their own estimate. The angle used is written to
+/ (2s)), which also inverts every arc (radial end faces, s = H, and
+W_b − W_t = 2H·sin(θ/2) whatever the arc's length), so all three targets are
+fixed points of their own estimate. The angle used is written to
 ``state[0]``.
 """
 import math
@@ -37,8 +44,11 @@ from ._registry import ElementType
 from ._rotation import fit_rotated
 from ._strip import distance, strip_widths
 
-HINGE_PARAMS = ("width", "height", "target", "sign", "max_angle", "floor", "exact_arc")
-W, H, TARGET, SIGN, MAX_ANGLE, FLOOR, EXACT = range(len(HINGE_PARAMS))
+HINGE_PARAMS = ("width", "height", "target", "sign", "max_angle", "floor", "model", "strips",
+                "series")
+W, H, TARGET, SIGN, MAX_ANGLE, FLOOR, MODEL, STRIPS, SERIES = range(len(HINGE_PARAMS))
+EQ8, ARC, AXIS = 0.0, 1.0, 2.0  # ``model`` codes (foldcore.hinges.HINGE_MODELS order)
+PIVOT_BLEND = 0.05  # width (× w) of the band in which the axis hinge turns into pivoting
 
 
 @njit(cache=True)
@@ -98,18 +108,57 @@ def limit_excess(x, indptr, indices, params, out):
 
 
 @njit(cache=True)
-def bent_shape(rest, width, phi, exact_arc, out):
+def axis_length(width, height, phi, theta):
+    """Neutral-axis length (mm) of an axis-true sub-strip of width w bent by φ (rad).
+
+    w·f(θ), f(θ) = (θ/2)/tan(θ/2), θ the bend of its whole crease (the sum
+    over its series of sub-strips): when the k sub-strips bend alike an arc
+    of that length has the end faces of a rotation by θ about the crease's
+    mid-line (same chord W·cos(θ/2), same directions). Never below H·|φ|/2,
+    the length at which the strip's inner surface has radius 0: from
+    θ* = 2·atan(W/H) on (the panels' inner edges touch there) the strip
+    pivots about its inner surface instead, so flat panels stack H apart
+    instead of overlapping. The switch is rounded (:func:`smooth_max`) where
+    the two lengths are within ``PIVOT_BLEND`` × w of each other (a few
+    degrees about θ*).
+    """
+    half = 0.5 * theta
+    if abs(half) < 1e-4:
+        f = 1.0 - half * half / 3.0
+    else:
+        f = half * math.cos(half) / math.sin(half)
+    return smooth_max(width * f, 0.5 * height * abs(phi), PIVOT_BLEND * width)
+
+
+@njit(cache=True)
+def smooth_max(a, b, delta):
+    """max(a, b), rounded over |a − b| < δ by the parabola that joins both lines with
+    matching slopes (C¹): the axis hinge's switch to pivoting has no kink for the
+    Gauss–Newton steps to stall at, and is exact outside that band."""
+    gap = a - b
+    if abs(gap) >= delta:
+        return max(a, b)
+    return 0.5 * (a + b) + gap * gap / (4.0 * delta) + 0.25 * delta
+
+
+@njit(cache=True)
+def bent_shape(rest, width, height, phi, model, theta, out):
     """Write the strip bent by ``phi`` (rad) into ``out`` (m, 3), centred, local frame.
 
-    Exact arc: a point at (x, y) goes to ((1 − κy) sin ψ / κ, 2 sin²(ψ/2)/κ + y cos ψ)
-    with κ = φ/W and ψ = κx, from s = sin(ψ/2), c = cos(ψ/2) (sin ψ = 2sc,
-    cos ψ = 1 − 2s², no cancellation at small ψ); the pair is computed once per
-    distinct rest x (a strip has two: its vertices share x across the thickness
-    and along the crease) and kept in ``out``'s rows meanwhile.
+    ``model``: ``EQ8`` trapezoid, ``ARC`` (neutral axis keeps its length w) or
+    ``AXIS`` (neutral axis of :func:`axis_length`, ``theta`` the crease's
+    bend). Arcs: a point at (x, y) goes to ((1 − κy) sin ψ / κ,
+    2 sin²(ψ/2)/κ + y cos ψ), ψ = φx/w, κ = φ/ℓ (ℓ the neutral-axis length),
+    from s = sin(ψ/2), c = cos(ψ/2) (sin ψ = 2sc, cos ψ = 1 − 2s², no
+    cancellation at small ψ); the pair is computed once per distinct rest x
+    (a strip has two: its vertices share x across the thickness and along the
+    crease) and kept in ``out``'s rows meanwhile.
     """
     m = rest.shape[0]
-    kappa = phi / width
-    if exact_arc and abs(kappa) * width >= 1e-12:
+    turn = phi / width  # ψ per mm of rest x
+    if model != EQ8 and abs(phi) >= 1e-12:
+        length = width if model == ARC else axis_length(width, height, phi, theta)
+        kappa = phi / length
         for k in range(m):  # pass 1: (sin ψ, cos ψ, 2 sin²(ψ/2)) per vertex
             shared = -1
             for j in range(k):
@@ -119,7 +168,7 @@ def bent_shape(rest, width, phi, exact_arc, out):
             if shared >= 0:
                 out[k, 0], out[k, 1], out[k, 2] = out[shared, 0], out[shared, 1], out[shared, 2]
             else:
-                half = 0.5 * kappa * rest[k, 0]
+                half = 0.5 * turn * rest[k, 0]
                 sh, ch = math.sin(half), math.cos(half)
                 out[k, 0], out[k, 1], out[k, 2] = 2.0 * sh * ch, 1.0 - 2.0 * sh * sh, 2.0 * sh * sh
         for k in range(m):  # pass 2: the bent point
@@ -131,7 +180,7 @@ def bent_shape(rest, width, phi, exact_arc, out):
     else:
         for k in range(m):
             x, y = rest[k, 0], rest[k, 1]
-            out[k, 0] = x * (1.0 - 2.0 * y / width * math.tan(0.5 * phi)) if not exact_arc else x
+            out[k, 0] = x * (1.0 - 2.0 * y / width * math.tan(0.5 * phi)) if model == EQ8 else x
             out[k, 1] = y
             out[k, 2] = rest[k, 2]
     for d in range(2):
@@ -143,41 +192,81 @@ def bent_shape(rest, width, phi, exact_arc, out):
 
 
 @njit(cache=True)
+def bend(rest, params, phi, theta, out):
+    """:func:`bent_shape` with a strip's own parameters (``HINGE_PARAMS``)."""
+    bent_shape(rest, params[W], params[H], phi, params[MODEL], theta, out)
+
+
+@njit(cache=True)
+def strip_angle(x, ids, params):
+    """Bend angle (rad) a strip is projected with: its target, or (passive) its
+    Eq. 9 estimate clamped to its interval."""
+    phi = params[TARGET]
+    if math.isnan(phi):
+        phi = clamp_angle(estimate_angle(x, ids), params[SIGN], params[FLOOR],
+                          params[MAX_ANGLE])
+    return phi
+
+
+@njit(cache=True)
+def series_bend(angles, params, e):
+    """θ (rad): the bend of strip ``e``'s whole crease, the sum of ``angles[j, 0]``
+    over its series of ``strips`` sub-strips (consecutive elements, ``series``
+    its place in them); an actuated strip's crease bends ``strips`` × its target.
+    A series that does not fit the group is taken as bending alike (k·φ)."""
+    p = params[e]
+    k = int(p[STRIPS])
+    first = e - int(p[SERIES])
+    if not math.isnan(p[TARGET]) or first < 0 or first + k > len(angles):
+        return k * angles[e, 0]
+    total = 0.0
+    for j in range(first, first + k):
+        total += angles[j, 0]
+    return total
+
+
+@njit(cache=True)
 def project(x, ids, rest, params, out, state):
-    """Rotated bent target of one sub-strip; returns its residual (mm²).
+    """Rotated bent target of one sub-strip, its crease bending alike (θ = kφ);
+    returns its residual (mm²). :func:`batch` takes θ from the strip's series.
 
     Parameters
     ----------
     x : (N, 3) current positions, mm
     ids : (8,) vertex ids in the order drawn in the module docstring
     rest : (8, 3) centred rest shape in the local frame, mm
-    params : (7,) see ``HINGE_PARAMS``
+    params : (9,) see ``HINGE_PARAMS``
     out : (8, 3) written: the rotated target, mm (holds the unrotated one first)
     state : (1,) written: the bend angle used, rad
     """
-    exact = params[EXACT] > 0.5
-    phi = params[TARGET]
-    if math.isnan(phi):
-        phi = clamp_angle(estimate_angle(x, ids), params[SIGN], params[FLOOR],
-                          params[MAX_ANGLE])
+    phi = strip_angle(x, ids, params)
     state[0] = phi
-    bent_shape(rest, params[W], phi, exact, out)
+    bend(rest, params, phi, params[STRIPS] * phi, out)
     return fit_rotated(x, ids, out, out)
 
 
 @njit(parallel=True, cache=True)
 def batch(x, indptr, indices, rest, params, out, energy, state):
-    """Project every sub-strip; ``energy[e]`` residual (mm²), ``state[e, 0]`` angle (rad)."""
+    """Project every sub-strip; ``energy[e]`` residual (mm²), ``state[e, 0]`` angle (rad).
+
+    Two passes: every strip's angle first (``state``), then every target from
+    its angle and its crease's bend (:func:`series_bend`), so a passive
+    crease whose sub-strips bend unequally shortens each of them for the
+    crease's total bend, not k times its own.
+    """
+    for e in prange(len(indptr) - 1):
+        state[e, 0] = strip_angle(x, indices[indptr[e]:indptr[e + 1]], params[e])
     for e in prange(len(indptr) - 1):
         s, t = indptr[e], indptr[e + 1]
-        energy[e] = project(x, indices[s:t], rest[s:t], params[e], out[s:t], state[e])
+        bend(rest[s:t], params[e], state[e, 0], series_bend(state, params, e), out[s:t])
+        energy[e] = fit_rotated(x, indices[s:t], out[s:t], out[s:t])
 
 
 @njit(parallel=True, cache=True)
 def prepare(indptr, rest, params, shapes):
     """Bent shape of every actuated strip into its rows of ``shapes`` (nnz, 3), mm.
 
-    Local frame, centred, as :func:`project` makes it: an actuated strip's
+    Local frame, centred, as :func:`batch` makes it: an actuated strip's
     target depends on its parameters only, so the engine computes it here
     once per change of targets instead of every iteration (Miura 50 × 50,
     19 600 strips: projection 6.8 → 6.0 ms per iteration on one thread,
@@ -188,30 +277,22 @@ def prepare(indptr, rest, params, shapes):
         phi = params[e, TARGET]
         if not math.isnan(phi):
             s, t = indptr[e], indptr[e + 1]
-            bent_shape(rest[s:t], params[e, W], phi, params[e, EXACT] > 0.5, shapes[s:t])
-
-
-@njit(cache=True)
-def project_prepared(x, ids, rest, shape, params, out, state):
-    """:func:`project` with an actuated strip's bent ``shape`` (m, 3) from :func:`prepare`.
-
-    Same arithmetic, so the same result to the last bit; passive strips are
-    projected by :func:`project` itself.
-    """
-    phi = params[TARGET]
-    if math.isnan(phi):
-        return project(x, ids, rest, params, out, state)
-    state[0] = phi
-    return fit_rotated(x, ids, shape, out)
+            bend(rest[s:t], params[e], phi, params[e, STRIPS] * phi, shapes[s:t])
 
 
 @njit(parallel=True, cache=True)
 def prepared_batch(x, indptr, indices, rest, shapes, params, out, energy, state):
-    """:func:`batch` with the actuated strips' bent shapes taken from ``shapes``."""
+    """:func:`batch` with the actuated strips' bent shapes taken from ``shapes``
+    (same arithmetic, so the same result to the last bit)."""
+    for e in prange(len(indptr) - 1):
+        state[e, 0] = strip_angle(x, indices[indptr[e]:indptr[e + 1]], params[e])
     for e in prange(len(indptr) - 1):
         s, t = indptr[e], indptr[e + 1]
-        energy[e] = project_prepared(x, indices[s:t], rest[s:t], shapes[s:t], params[e],
-                                     out[s:t], state[e])
+        if math.isnan(params[e, TARGET]):
+            bend(rest[s:t], params[e], state[e, 0], series_bend(state, params, e), out[s:t])
+            energy[e] = fit_rotated(x, indices[s:t], out[s:t], out[s:t])
+        else:
+            energy[e] = fit_rotated(x, indices[s:t], shapes[s:t], out[s:t])
 
 
 SHAPE_STEP = 1e-6  # rad, central-difference step of ``shapes``' derivative
@@ -231,20 +312,21 @@ def shapes(indptr, rest, params, phi, out, d_out):
     ----------
     indptr : (S+1,) int64, slots of each strip
     rest : (nnz, 3) centred rest shapes, mm
-    params : (S, 7) see ``HINGE_PARAMS``
-    phi : (S,) bend angle per strip, rad
+    params : (S, 9) see ``HINGE_PARAMS``
+    phi : (S,) bend angle per strip, rad (the strips of a crease alike)
     out : (nnz, 3) written: T(φ), mm
     d_out : (nnz, 3) written: dT/dφ, mm/rad
     """
     for e in prange(len(indptr) - 1):
         s, t = indptr[e], indptr[e + 1]
-        exact = params[e, EXACT] > 0.5
-        bent_shape(rest[s:t], params[e, W], phi[e] + SHAPE_STEP, exact, d_out[s:t])
-        bent_shape(rest[s:t], params[e, W], phi[e] - SHAPE_STEP, exact, out[s:t])
+        strips = params[e, STRIPS]  # the rigid strategy bends a crease's strips alike
+        up, down = phi[e] + SHAPE_STEP, phi[e] - SHAPE_STEP
+        bend(rest[s:t], params[e], up, strips * up, d_out[s:t])
+        bend(rest[s:t], params[e], down, strips * down, out[s:t])
         for k in range(s, t):
             for d in range(3):
                 d_out[k, d] = (d_out[k, d] - out[k, d]) / (2.0 * SHAPE_STEP)
-        bent_shape(rest[s:t], params[e, W], phi[e], exact, out[s:t])
+        bend(rest[s:t], params[e], phi[e], strips * phi[e], out[s:t])
 
 
 class BendingHinge(ElementType):

@@ -20,6 +20,7 @@ import argparse
 import sys
 import warnings
 
+from .hinges import DEFAULT_HINGE, HINGE_MODELS
 from .strategies import DEFAULT_SOLVER, SOLVERS
 
 EXIT_BAD_INPUT = 2
@@ -114,8 +115,13 @@ def build_parser() -> argparse.ArgumentParser:
     sim.add_argument("--tolerance", type=_positive, default=1e-8,
                      help="stop when the largest step is below this × pattern size")
     sim.add_argument("--max-iterations", type=int, default=10_000)
-    sim.add_argument("--eq8", action="store_true",
-                     help="use Eq. 8 trapezoid hinge targets instead of the exact arc")
+    sim.add_argument("--hinge", choices=HINGE_MODELS,
+                     help="hinge model of every crease: axis (panels turn about the crease, "
+                          "rigid-origami kinematics at any thickness), arc (the paper's "
+                          "constant-length arc) or eq8 (the paper's Eq. 8 trapezoid); default: "
+                          f"the file's foldcore:edges_hinge, else {DEFAULT_HINGE}")
+    sim.add_argument("--eq8", dest="hinge", action="store_const", const="eq8",
+                     help="same as --hinge eq8")
     sim.add_argument("-o", "--output", help="write the result as FOLD (achieved angles + "
                                             "folded solid in file_frames)")
     sim.add_argument("--report", help="write the JSON report here")
@@ -191,8 +197,8 @@ def _load(args):
         if args.hinges:
             raise PatternError(f"{args.pattern}: --hinges only goes with an OBJ/STL pattern")
         fold = read_fold_file(args.pattern)
-        return fold.pattern, fold.thickness, fold.stiffness
-    return read(args.pattern, hinges=args.hinges), None, None
+        return fold.pattern, fold.thickness, fold.stiffness, fold.hinge
+    return read(args.pattern, hinges=args.hinges), None, None, None
 
 
 def simulate(args) -> int:
@@ -204,7 +210,7 @@ def simulate(args) -> int:
 
     if args.max_iterations < 1:
         raise SimulationError(f"--max-iterations must be ≥ 1, got {args.max_iterations}")
-    pattern, file_thickness, stiffness = _load(args)
+    pattern, file_thickness, stiffness, file_hinges = _load(args)
     thickness = args.thickness or file_thickness
     if thickness is None:
         raise SimulationError(f"{args.pattern}: no thickness: pass --thickness H (mm) "
@@ -213,7 +219,7 @@ def simulate(args) -> int:
         from .animate import check_output
         check_output(args.animate)          # a missing encoder fails before any work
     mesh = thicken(pattern, thickness, args.hinge_width, args.subdivisions,
-                   exact_arc=not args.eq8, stiffness=stiffness)
+                   hinge=args.hinge or file_hinges, stiffness=stiffness)
     sim = Simulation(mesh, pattern, solver=args.solver)
     if args.animate:
         result = _animate(args, sim)
@@ -226,7 +232,7 @@ def simulate(args) -> int:
               file=sys.stderr)
     settings = {k: getattr(args, k) for k in ("pattern", "fold_percent", "solver",
                                               "tolerance", "max_iterations", "subdivisions")}
-    settings.update(thickness_mm=thickness, exact_arc=not args.eq8,
+    settings.update(thickness_mm=thickness, hinge=sorted(set(mesh.hinge_model) - {""}),
                     backend=sim.system.factor.backend)
     write_result(result, pattern, mesh, thickness, settings, fold=args.output,
                  report=args.report, png=args.render)

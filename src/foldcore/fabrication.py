@@ -408,8 +408,9 @@ def read_result(path, hinge_width=None, subdivisions=None) -> ResultFile:
     hinge_width : float, optional
         mm; as given to simulate (``--hinge-width``); default: the file's widths.
     subdivisions : int or "auto", optional
-        As given to simulate; default: try ``auto`` (exact arc, then Eq. 8),
-        then 1 … 16 sub-strips on every crease.
+        As given to simulate; default: try ``auto`` (with the file's hinge
+        models, ``foldcore:edges_hinge``; without them the default model,
+        then Eq. 8), then 1 … 16 sub-strips on every crease.
 
     Raises
     ------
@@ -428,7 +429,8 @@ def read_result(path, hinge_width=None, subdivisions=None) -> ResultFile:
     if fold.thickness is None:
         raise PatternError(f"{source}: no foldcore:thickness; not a foldcore result file")
     recipe = {"elastic": faces_cells(d, len(fold.pattern.faces), source) or None,
-              "stretch": edges_poisson(d, fold.pattern.n_edges, source) or None}
+              "stretch": edges_poisson(d, fold.pattern.n_edges, source) or None,
+              "hinge": fold.hinge}
     mesh = _matching_mesh(fold.pattern, fold.thickness, hinge_width, subdivisions,
                           positions, faces, source, recipe)
     panels = mesh.groups[mesh.panel_group]
@@ -476,22 +478,23 @@ def _folded_frame(d: dict, source: str):
 def _matching_mesh(pattern, thickness, hinge_width, subdivisions, positions, faces, source,
                    recipe=None):
     """The ThickMesh whose outer faces are ``faces`` (see :func:`read_result`);
-    ``recipe``: thicken's ``elastic``/``stretch`` as stored in the file."""
+    ``recipe``: thicken's ``elastic``/``stretch``/``hinge`` as stored in the file."""
     from .errors import MeshError
     from .mesh import surface_faces
     from .thickening import MAX_SUBDIVISIONS, thicken
 
+    recipe = dict(recipe or {})
+    hinge = recipe.pop("hinge", None)
     if subdivisions is not None:
-        candidates = [(subdivisions, True)]
-    else:
-        candidates = [("auto", True), ("auto", False)] + \
-                     [(k, True) for k in range(1, MAX_SUBDIVISIONS + 1)]
+        candidates = [(subdivisions, hinge)]
+    else:  # without stored models: the default, then Eq. 8 (whose auto counts differ)
+        candidates = [("auto", hinge)] + ([("auto", "eq8")] if hinge is None else []) + \
+                     [(k, hinge) for k in range(1, MAX_SUBDIVISIONS + 1)]
     wanted = sorted(tuple(sorted(f)) for f in faces)
     first_error = None
-    for k, exact in candidates:
+    for k, model in candidates:
         try:
-            mesh = thicken(pattern, thickness, hinge_width, k, exact_arc=exact,
-                           **(recipe or {}))
+            mesh = thicken(pattern, thickness, hinge_width, k, hinge=model, **recipe)
         except MeshError as exc:
             first_error = first_error or exc
             continue

@@ -83,6 +83,10 @@ class ThickMesh:
         The elastic faces as built (counts resolved: ``"auto"`` replaced),
         so the same mesh can be rebuilt (stored in result FOLD files as
         ``foldcore:faces_cells``); empty for rigid panels only.
+    hinge_model : (E,) str, optional
+        Hinge kinematics of each crease's bending strips (``"axis"``,
+        ``"arc"``, ``"eq8"``; ``""`` for boundary edges), see
+        :func:`foldcore.thicken`.
     """
 
     points: np.ndarray
@@ -95,6 +99,7 @@ class ThickMesh:
     segments: np.ndarray | None = None
     panel_group: str = "rigid_panel"
     elastic: dict = field(default_factory=dict)
+    hinge_model: np.ndarray | None = None
 
     def __post_init__(self):
         if self.segments is None:

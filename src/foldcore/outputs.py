@@ -9,7 +9,7 @@ import platform
 
 import numpy as np
 
-from .io.fold import CELLS_KEY, POISSON_KEY
+from .io.fold import CELLS_KEY, HINGE_KEY, POISSON_KEY
 from .mesh import surface_faces
 
 
@@ -90,11 +90,15 @@ def write_report(path, report: dict) -> None:
 
 def _mesh_recipe(pattern, mesh) -> dict | None:
     """FOLD keys that let a reader rebuild a mesh thicken() cannot guess: the elastic
-    faces' cell counts (``foldcore:faces_cells``, null for a rigid panel) and the
-    stretch hinges' Poisson ratios (``foldcore:edges_poisson``, null elsewhere)."""
+    faces' cell counts (``foldcore:faces_cells``, null for a rigid panel), the
+    stretch hinges' Poisson ratios (``foldcore:edges_poisson``, null elsewhere)
+    and the hinge model of every crease (``foldcore:edges_hinge``, null on
+    boundary edges)."""
     from elements.stretch_hinge import STRETCH_PARAMS
 
     recipe = {}
+    if mesh.hinge_model is not None:
+        recipe[HINGE_KEY] = [str(m) if m else None for m in mesh.hinge_model]
     if mesh.elastic:
         cells = [None] * len(pattern.faces)
         for f, n in mesh.elastic.items():

@@ -16,7 +16,7 @@ from . import kinematics
 from .errors import PatternError
 from .pattern import CreasePattern
 
-__all__ = ["degree4_vertex", "waterbomb", "miura", "miura_edge_kinds", "miura_fold_angles",
+__all__ = ["degree4_vertex", "single_vertex", "waterbomb", "miura", "miura_edge_kinds", "miura_fold_angles",
            "single_hinge", "grid", "degree4_assignments"]
 
 PEHRSON_SECTORS = (135.0, 90.0, 45.0, 90.0)
@@ -72,14 +72,60 @@ def degree4_vertex(sectors=PEHRSON_SECTORS, radius: float = 76.2, widths=PEHRSON
             raise PatternError("degree4_vertex: mode A/B is defined for flat-foldable "
                                "vertices only; pass assignments for a general vertex")
         assignments = degree4_assignments(sectors, mode, -1.0 if _neg(rho1) else 1.0)
+    return _vertex_pattern(sectors, radius, widths, assignments, [rho1, None, None, None],
+                           "degree4_vertex")
+
+
+def single_vertex(sectors, assignments, fold_angles=None, radius: float = 50.0,
+                  widths=None) -> CreasePattern:
+    """One vertex of any degree n ≥ 3 on a polygonal disc.
+
+    Parameters
+    ----------
+    sectors : n floats, degrees
+        Sector α_i between crease i and crease i+1 (CCW); each in (0, 180),
+        summing to 360. Crease 1 is at 0°, crease i at α_1 + … + α_{i−1}.
+    assignments : n str
+        ``M``/``V``/``F``/``U`` of the creases.
+    fold_angles : n floats or None, degrees, optional
+        Target per crease (valley > 0); None = passive (default: all passive).
+    radius : float, mm
+    widths : n floats or None, mm, optional
+
+    Returns
+    -------
+    CreasePattern
+        Vertex 0 the centre, vertex i+1 the end of crease i+1, then extra rim
+        vertices; edges 0..n−1 the creases, then the rim CCW; faces the sectors.
+    """
+    sectors = np.asarray(sectors, dtype=float)
+    if sectors.ndim != 1 or len(sectors) < 3:
+        raise PatternError(f"single_vertex: need at least 3 sector angles, got {sectors.size}")
+    if not (np.all(sectors > 0) and np.all(sectors < 180)):
+        raise PatternError(f"single_vertex: sector angles {sectors.tolist()}° must each be "
+                           "in (0, 180)")
+    if abs(sectors.sum() - 360.0) > _TOL:
+        raise PatternError(f"single_vertex: sector angles {sectors.tolist()}° sum to "
+                           f"{sectors.sum():g}°, not 360°")
+    if len(assignments) != len(sectors):
+        raise PatternError(f"single_vertex: {len(assignments)} assignments for "
+                           f"{len(sectors)} creases")
+    _check_positive(radius=radius)
+    angles = list(fold_angles) if fold_angles is not None else [None] * len(sectors)
+    return _vertex_pattern(sectors, radius, widths, assignments, angles, "single_vertex")
+
+
+def _vertex_pattern(sectors, radius, widths, assignments, angles, source) -> CreasePattern:
+    """Crease pattern of one vertex: creases from the centre, rim chords, sectors."""
+    n = len(sectors)
     vertices, rim = _disc_vertices(sectors, radius)
-    edges = [(0, i + 1) for i in range(4)] + list(zip(rim, np.roll(rim, -1)))
+    edges = [(0, i + 1) for i in range(n)] + list(zip(rim, np.roll(rim, -1)))
     n_rim = len(rim)
     return CreasePattern(
         vertices, edges, list(assignments) + ["B"] * n_rim,
-        fold_angles=[rho1] + [None] * (3 + n_rim),
-        widths=list(widths if widths is not None else [None] * 4) + [None] * n_rim,
-        source="degree4_vertex")
+        fold_angles=list(angles) + [None] * n_rim,
+        widths=list(widths if widths is not None else [None] * n) + [None] * n_rim,
+        source=source)
 
 
 def degree4_assignments(sectors, mode: str = "A", sign: float = 1.0) -> list[str]:
@@ -121,8 +167,8 @@ def _check_sectors(sectors, flat_foldable: bool) -> np.ndarray:
 
 
 def _disc_vertices(sectors: np.ndarray, radius: float) -> tuple[np.ndarray, list[int]]:
-    """Centre, crease ends (ids 1..4), extra rim points; rim loop ids CCW."""
-    starts = np.concatenate([[0.0], np.cumsum(sectors)[:3]])
+    """Centre, crease ends (ids 1..n), extra rim points; rim loop ids CCW."""
+    starts = np.concatenate([[0.0], np.cumsum(sectors)[:-1]])
     angles, rim = list(starts), []
     for i, (start, width) in enumerate(zip(starts, sectors)):
         rim.append(i + 1)

@@ -112,6 +112,7 @@ class RigidBodySolver:
                                   f"(mesh has {sorted(mesh.groups)}); use solver='paper'")
         self.sim = sim
         self.backend = sim.system.factor.backend
+        self._weights_version = None  # K's version the strip weights were read at
         self._init_panels(mesh.groups["rigid_panel"], mesh.n_vertices, sim.x)
         self._init_strips(sim._hinges)
         self._init_mv_sides(mesh, sim.pattern)
@@ -173,15 +174,24 @@ class RigidBodySolver:
         jointless = np.bincount(p, weights=slots, minlength=len(self.rot_p)) == 0
         self.joint_weight = np.where(jointless[p], 1.0, slots.astype(float))
         self.ids = g.indices.reshape(-1, 8)
-        self.sqrt_w = np.sqrt(self.sim.system.weights[self.sim._hinge_index])
+        self._sync_weights()
         s = len(g)
         self.phi = np.zeros(s)
         self.k_strip = self.sim.mesh.subdivisions[g.source].astype(float)
         self.shape = np.zeros((8 * s, 3))
         self.d_shape = np.zeros((8 * s, 3))
-        self.jx = self._strip_position_jacobian()
         self._init_carriers(self.sim.mesh, self.sim.pattern)
         self.rot_e = np.tile(np.eye(3), (s, 1, 1))
+
+    def _sync_weights(self) -> None:
+        """Strip weights (√w) and the position Jacobian from the Simulation's current
+        weights (actuation and stops change them; K's version says when)."""
+        system = self.sim.system
+        if self._weights_version == system.version:
+            return
+        self._weights_version = system.version
+        self.sqrt_w = np.sqrt(system.weights[self.sim._hinge_index])
+        self.jx = self._strip_position_jacobian()
 
     def _init_carriers(self, mesh, pattern) -> None:
         """Blend weights that carry each free (hinge-interior) vertex with its two panels.
@@ -481,6 +491,7 @@ class RigidBodySolver:
         moved : float
             Largest vertex displacement of the step tried, mm (accepted or not).
         """
+        self._sync_weights()
         self._read_targets()
         self._update_shapes(self.phi)
         if not self._fitted:  # strips' rotations start at their exact fit

@@ -11,7 +11,7 @@ import numba
 import numpy as np
 
 import elements
-from elements.bending_hinge import FLOOR, TARGET, limit_excess
+from elements.bending_hinge import FLOOR, SIGN, TARGET, limit_excess
 from . import strategies
 from .errors import SimulationError
 from .measure import fold_angles
@@ -26,6 +26,11 @@ STOP_LEAVE = 1e-3  # rad back inside its interval before a stop is released
 # 2-core Xeon, paper map, ms/iteration 1 vs 2 threads: Miura 2×2 (108 slots) 0.070 vs
 # 0.063 quiet / 2.3 with the cores busy; 5×5 (936) 0.41 vs 0.28; 10×10 (4 076) 1.77 vs 1.09.
 SERIAL_BELOW_SLOTS = 500
+ACTUATION_STIFFNESS = 1e3  # weight multiplier of actuated strips under actuation="angle"
+ACTUATIONS = ("angle", "equal")
+BRANCH_FLOOR_DEG = 2.0  # default floor of the branch stage (Simulation.branch_floor_deg)
+BRANCH_TOLERANCE = 1e-6  # relative step at which the branch stage hands over
+DEFAULT_ACTUATION = "equal"  # why: the Simulation docstring (actuation)
 BARE_SOLVE_REPEATS = 5  # solves timed for the per-iteration cost floor
 
 
@@ -153,6 +158,11 @@ class Simulation:
     passive_floor_deg : float
         Fold magnitude (degrees per crease) a passive M/V hinge is given when
         its estimate has the wrong sign (§4.2 "a small value"); default 0.
+    branch_floor_deg : float
+        Branch selection by assignment (degrees, ≥ 0; 0 turns it off): a run
+        that starts from a flat sheet with some crease driven first folds with
+        every passive M/V crease held at least this far on its assigned side,
+        then releases them (:meth:`run`). Default ``BRANCH_FLOOR_DEG`` (2°).
     stop_stiffness : float
         Weight multiplier (dimensionless, ≥ 1) of a passive sub-strip bent
         past its max angle by more than ``STOP_ENTER``: the joint closes and
@@ -173,6 +183,19 @@ class Simulation:
         checked where a result is taken (the end of each ``run``, or
         :meth:`result`): sweep ``set_fold_percent`` to locate a first
         failure along a path.
+    actuation : {"equal", "angle"}
+        What an actuated crease is. ``"equal"`` (default, the paper's): an
+        actuated strip weighs what a passive one does (a hinge with a rest
+        angle), so where the model cannot meet every target at once (binding
+        vertices, conflicting targets, position targets) the actuated creases
+        share the misfit. ``"angle"``: angle-controlled — its strips weigh
+        ``ACTUATION_STIFFNESS`` (10³) times their volume, as if a stiff
+        actuator held the angle, so the passive creases and panels give way
+        and the actuated angles are reached. Where every target can be met
+        both give the same state. Why ``"equal"`` is the default (measured,
+        bench/accuracy): with the axis hinge both reach the closed forms, and
+        the stiffness contrast of ``"angle"`` slows L-BFGS and can stall the
+        rigid strategy (a thin mode-B vertex stopped at 12.7° of 60°).
     threads : int, optional
         numba threads for the kernels of this simulation (set at each step,
         so simulations in one process do not override each other). Default:
@@ -184,7 +207,9 @@ class Simulation:
 
     def __init__(self, mesh, pattern, solver: str = DEFAULT_SOLVER, backend: str = "auto",
                  passive_floor_deg: float = 0.0, stop_stiffness: float = 1e3,
-                 threads: int | None = None, strain_limits=None):
+                 threads: int | None = None, strain_limits=None,
+                 actuation: str = DEFAULT_ACTUATION,
+                 branch_floor_deg: float = BRANCH_FLOOR_DEG):
         start = time.perf_counter()
         try:
             strategy = strategies.get(solver)
@@ -199,18 +224,34 @@ class Simulation:
                 offset += len(g.indices)
         self.threads = self._choose_threads(threads, offset)
         self._check_every_vertex_used()
+        if actuation not in ACTUATIONS:
+            raise SimulationError(f"unknown actuation {actuation!r} (available: "
+                                  f"{', '.join(ACTUATIONS)})")
+        self.actuation = actuation
+        if not (np.isfinite(branch_floor_deg) and branch_floor_deg >= 0):
+            raise SimulationError(f"branch_floor_deg must be ≥ 0 degrees, got "
+                                  f"{branch_floor_deg!r}")
+        self.branch_floor_deg = float(branch_floor_deg)
+        self.branch_iterations = 0  # iterations spent in branch stages (run docstring)
         self._targets = np.zeros((offset, 3))
         # column-major: CHOLMOD's own layout, so the solve copies nothing in
         self._rhs = np.zeros((mesh.n_vertices, 3), order="F")
-        self.system = System([r.group for r in self._runs], mesh.n_vertices, backend)
         self._hinges = next((r for r in self._runs if r.group.kind == "bending_hinge"), None)
         self._stretch = next((r for r in self._runs if r.group.kind == "stretch_hinge"), None)
+        self.system = None
         self._init_stops(stop_stiffness)
         self._fold_targets = np.array(pattern.fold_angles, dtype=float)
         self._fold_targets[pattern.assignments == "F"] = 0.0
         self._percent = 100.0
-        self._set_floor(passive_floor_deg)
+        if not (np.isfinite(passive_floor_deg) and passive_floor_deg >= 0):
+            raise SimulationError(f"passive floor must be ≥ 0 degrees, got "
+                                  f"{passive_floor_deg!r}")
+        self._passive_floor_deg = float(passive_floor_deg)  # the user's, kept across stages
+        self._set_floor(self._passive_floor_deg)
         self._apply_fold_targets()
+        weights = [r.group.weights if r is not self._hinges else self._hinge_weights()
+                   for r in self._runs]
+        self.system = System([r.group for r in self._runs], mesh.n_vertices, backend, weights)
         self._position_targets: dict[str, PositionTarget] = {}
         self._update_pins()
         self.iterations = 0
@@ -398,6 +439,15 @@ class Simulation:
     def run(self, tolerance: float = 1e-8, max_iterations: int = 10_000, callback=None) -> Result:
         """Iterate until the largest step is ≤ ``tolerance`` × pattern size.
 
+        From a flat sheet (every crease within ``branch_floor_deg`` of 0°) with
+        a crease driven and passive M/V creases, the run has two stages: the
+        branch stage (passive M/V creases held ≥ ``branch_floor_deg`` on their
+        assigned side, to a relative step of ``BRANCH_TOLERANCE`` or the run's
+        tolerance if looser), then the run itself from there with the floor
+        released. Both count in ``max_iterations`` and in ``iterations``
+        (``branch_iterations`` counts the first). A run from a folded state is
+        a single stage.
+
         Parameters
         ----------
         tolerance : float
@@ -414,14 +464,58 @@ class Simulation:
         budget, limit = int(max_iterations), tolerance * self.length_scale
         moved, stopped = np.inf, False
         with blas_on_one_thread(self.threads > 1):
-            self.strategy.begin_run()
-            try:
-                moved, stopped = self._iterate(budget, callback, limit)
-            finally:
-                self.strategy.end_run()
+            if self._starts_flat():
+                used, moved, stopped = self._branch_stage(budget, callback, limit)
+                budget -= used
+            if budget > 0 and not stopped:
+                _, moved, stopped = self._stage(budget, callback, limit)
         self.timings["total"] += time.perf_counter() - start
         self.timings["bare_solve"] = self._bare_solve_floor()
         return self.result(not stopped and moved <= limit)
+
+    def _stage(self, budget: int, callback, limit: float) -> tuple[int, float, bool]:
+        """One bracketed stretch of strategy steps (:meth:`_iterate`); returns
+        (steps taken, last move mm, whether the callback stopped)."""
+        before = self.iterations
+        self.strategy.begin_run()
+        try:
+            moved, stopped = self._iterate(budget, callback, limit)
+        finally:
+            self.strategy.end_run()
+        return self.iterations - before, moved, stopped
+
+    def _starts_flat(self) -> bool:
+        """Whether this run needs the branch stage: a floor is set, some passive crease
+        is M or V, some crease is driven away from flat, and the sheet is still flat
+        (every crease within the floor of 0°, measured from the panels)."""
+        if self.branch_floor_deg <= 0 or self._hinges is None:
+            return False
+        params = self._hinges.params
+        assigned = self._passive & (params[:, SIGN] != 0.0)
+        driven = ~self._passive & (params[:, TARGET] != 0.0)
+        if not assigned.any() or not driven.any():
+            return False
+        angles = self.fold_angles()
+        return bool(np.nanmax(np.abs(angles), initial=0.0) < self.branch_floor_deg)
+
+    def _branch_stage(self, budget: int, callback, limit: float) -> tuple[int, float, bool]:
+        """Fold from flat with every passive M/V crease held at least
+        ``branch_floor_deg`` on its assigned side, to ``BRANCH_TOLERANCE`` (or the
+        run's, if looser), then release the floor to the user's: the flat state is
+        a bifurcation, and the floor puts the sheet on the branch its assignment
+        names before the passive creases are free (thick Miura 10 × 10 with one
+        crease driven: jammed 60° short without it, exact with it; bench/accuracy)."""
+        floor = self._passive_floor_deg
+        self._set_floor(max(floor, self.branch_floor_deg))
+        self._targets_changed()
+        try:
+            result = self._stage(budget, callback,
+                                 max(limit, BRANCH_TOLERANCE * self.length_scale))
+        finally:
+            self._set_floor(floor)
+            self._targets_changed()
+        self.branch_iterations += result[0]
+        return result
 
     def _iterate(self, budget: int, callback, limit: float) -> tuple[float, bool]:
         """Up to ``budget`` steps, until the strategy is settled (a step moved ≤
@@ -571,6 +665,21 @@ class Simulation:
         target = np.radians(self._fold_targets[src] * self._percent / 100.0) / k
         self._hinges.set_params(slice(None), TARGET, target)
         self._passive = np.isnan(target)
+        self._sync_hinge_weights()
+
+    def _hinge_weights(self) -> np.ndarray:
+        """(S,) hinge strip weights, mm³: their volume weights × the stop factor on
+        stops × ``ACTUATION_STIFFNESS`` on actuated strips under ``actuation="angle"``."""
+        g = self._hinges.group
+        factor = np.where(self.stops, self._stop_factor, 1.0)
+        if self.actuation == "angle":
+            factor = factor * np.where(self._passive, 1.0, ACTUATION_STIFFNESS)
+        return factor * g.weights
+
+    def _sync_hinge_weights(self) -> None:
+        """Hand the current hinge weights to K (a numeric refactor if they changed)."""
+        if self.system is not None and self._hinges is not None:
+            self.system.set_weights(self._hinge_index, self._hinge_weights())
 
     def _init_stops(self, stop_stiffness: float) -> None:
         if not (np.isfinite(stop_stiffness) and stop_stiffness >= 1.0):
@@ -597,12 +706,9 @@ class Simulation:
         if np.array_equal(stops, self.stops):
             return
         self.stops = stops
-        self.system.set_weights(self._hinge_index,
-                                np.where(stops, self._stop_factor, 1.0) * g.weights)
+        self._sync_hinge_weights()
 
     def _set_floor(self, floor_deg: float) -> None:
-        if not (np.isfinite(floor_deg) and floor_deg >= 0):
-            raise SimulationError(f"passive floor must be ≥ 0 degrees, got {floor_deg!r}")
         if self._hinges is not None:
             k = self.mesh.subdivisions[self._hinges.group.source]
             self._hinges.set_params(slice(None), FLOOR, np.radians(floor_deg) / k)

@@ -4,7 +4,12 @@ A sub-strip of width w = W/k and thickness H bent by φ (its share of the
 crease's angle, valley > 0) stretches its faces by s(y) − 1, y = ±H/2 the
 top/bottom face (the neutral surface y = 0 keeps its length):
 
-* exact arc (foldcore's default target): s(y) = 1 − φ·y/w, so
+* axis-true hinge (foldcore's default): the neutral axis has the length
+  ℓ = max(w·f(kφ), H|φ|/2), f(θ) = (θ/2)/tan(θ/2)
+  (:func:`elements.bending_hinge.axis_length`), so s(y) = (ℓ − φy)/w:
+  ε = ℓ/w − 1 ∓ φH/(2w) — the whole strip shortens by 1 − f as it bends
+  (θ = 90°: 21 %), which is what lets the panels turn about the crease;
+* constant-length arc (the paper's Eq. 7): ℓ = w, s(y) = 1 − φ·y/w, so
   ε_top = −φH/(2w), ε_bottom = +φH/(2w);
 * Eq. 8 trapezoid: s(y) = 1 − (2y/w)·tan(φ/2), so
   ε_top = −(H/w)·tan(φ/2), ε_bottom = +(H/w)·tan(φ/2).
@@ -22,7 +27,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from elements.bending_hinge import EXACT, H, W, estimate_angles
+from elements.bending_hinge import AXIS, EQ8, H, MODEL, STRIPS, W, estimate_angles
+from .hinges import neutral_length
 
 TOP, BOTTOM = 0, 1
 
@@ -30,14 +36,24 @@ TOP, BOTTOM = 0, 1
 def strip_strains(params: np.ndarray, phi: np.ndarray) -> np.ndarray:
     """(S, 2) surface strains (top, bottom) of sub-strips bent by ``phi`` (S,) rad.
 
-    ``params`` (S, 7) are the hinge parameters (``HINGE_PARAMS``): width w,
-    height H and the target kind decide the formula (module docstring).
+    ``params`` (S, 8) are the hinge parameters (``HINGE_PARAMS``): width w,
+    height H, the hinge model and its sub-strip count decide the formula
+    (module docstring).
     """
     ratio = params[:, H] / params[:, W]
-    arc = 0.5 * phi * ratio
-    trapezoid = ratio * np.tan(0.5 * phi)
-    bottom = np.where(params[:, EXACT] > 0.5, arc, trapezoid)
-    return np.column_stack([-bottom, bottom])
+    model = params[:, MODEL]
+    bend = np.where(model == EQ8, ratio * np.tan(0.5 * phi), 0.5 * phi * ratio)
+    axial = neutral_lengths(params, phi) / params[:, W] - 1.0
+    return np.column_stack([axial - bend, axial + bend])
+
+
+def neutral_lengths(params: np.ndarray, phi: np.ndarray) -> np.ndarray:
+    """(S,) neutral-axis length (mm) of sub-strips bent by ``phi`` (S,) rad, each
+    crease's strips alike: 1/k of their crease's for axis hinges
+    (:func:`foldcore.hinges.neutral_length`), the width w for the others."""
+    k = params[:, STRIPS]
+    axis = neutral_length("axis", k * params[:, W], params[:, H], k * phi) / k
+    return np.where(params[:, MODEL] == AXIS, axis, params[:, W])
 
 
 def estimated_strip_angles(hinge_group, positions: np.ndarray) -> np.ndarray:

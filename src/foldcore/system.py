@@ -115,25 +115,32 @@ class System:
     n_vertices : int
     backend : str
         Linear-solver backend (see :class:`foldcore.linsolve.Factor`).
+    weights : sequence of (n_g,) float, optional
+        Element weights to factor K with first, mm³ (default: the groups' own;
+        a Simulation passes its actuation's and stops' weights, so the first
+        factorisation is already the one it needs).
 
     Attributes
     ----------
     reference_weight : float
-        Mean diagonal of K at the rest weights (mm³): the scale that makes pin
-        weights dimensionless.
+        Mean diagonal of K at the groups' own weights, Σ_e w_e (m_e − 1) / N
+        (mm³; m_e vertices per element): the scale that makes pin weights
+        dimensionless.
     weights : list of (n_g,) float
-        Current element weights of each group, mm³ (start: the groups' own).
+        Current element weights of each group, mm³.
     version : int
         Number of refactorisations since construction: a change tells an
         accelerated strategy that K changed and its history is stale.
     """
 
-    def __init__(self, groups, n_vertices: int, backend: str = "auto"):
+    def __init__(self, groups, n_vertices: int, backend: str = "auto", weights=None):
         self.n_vertices = n_vertices
         self.groups = list(groups)
-        self.weights = [np.array(g.weights, dtype=float) for g in self.groups]
+        self.reference_weight = sum(float(g.weights @ (np.diff(g.indptr) - 1))
+                                    for g in self.groups) / max(n_vertices, 1)
+        own = [g.weights for g in self.groups]
+        self.weights = [np.array(w, dtype=float) for w in (own if weights is None else weights)]
         self._assemble()
-        self.reference_weight = float(self.matrix.diagonal().mean())
         indices = np.concatenate([g.indices for g in self.groups])
         self.v_indptr, self.v_slots = vertex_slots(indices, n_vertices)
         self._pins = np.zeros(n_vertices)

@@ -18,6 +18,7 @@ import numpy as np
 
 from elements.bending_hinge import HINGE_PARAMS
 from .errors import MeshError
+from .hinges import DEFAULT_HINGE, HINGE_MODELS
 from .mesh import ElementGroup, ThickMesh
 from .pattern import CreasePattern
 
@@ -30,25 +31,25 @@ def minimum_hinge_width(thickness: float, max_angle_deg, bend_radius: float = 0.
     return (bend_radius + 0.5 * thickness) * np.radians(max_angle_deg)
 
 
-def auto_subdivisions(width, thickness: float, max_angle_deg,
-                      exact_arc: bool = False) -> np.ndarray:
+def auto_subdivisions(width, thickness: float, max_angle_deg, hinge="axis") -> np.ndarray:
     """Sub-strips per hinge chosen from its largest fold angle.
 
     Rule: k = max(2, ceil(θmax / 45°)) (smoothness, paper §6.1). With Eq. 8
-    targets k is then raised (up to 16) while one sub-strip of width W/k
-    cannot reach θmax/k: its limit is 2·atan(W/(k·H)) (top face shrinks to
-    zero length). Exact-arc targets have no per-strip limit: the hinge reaches
-    2W/H whatever k (the inner face of the arc shrinks to zero there), so only
-    the smoothness rule applies. With Eq. 7's minimum width (r = 0) the Eq. 8
-    rule can never be met (θ/k > 2·atan(θ/2k) for all k) and stops at 16.
+    targets (``hinge="eq8"``, per hinge or for all) k is then raised (up to
+    16) while one sub-strip of width W/k cannot reach θmax/k: its limit is
+    2·atan(W/(k·H)) (top face shrinks to zero length). Arc and axis targets
+    have no per-strip limit (an arc's inner face shrinks to zero at 2W/H
+    whatever k; the axis hinge pivots about its inner surface past
+    2·atan(W/H)), so only the smoothness rule applies. With Eq. 7's minimum
+    width (r = 0) the Eq. 8 rule can never be met (θ/k > 2·atan(θ/2k) for
+    all k) and stops at 16.
     """
     width = np.atleast_1d(np.asarray(width, dtype=float))
     theta = np.radians(np.broadcast_to(max_angle_deg, width.shape))
+    eq8 = np.broadcast_to(np.asarray(hinge) == "eq8", width.shape)
     k = np.maximum(2, np.ceil(np.degrees(theta) / 45.0 - 1e-9)).astype(np.int64)
-    if exact_arc:
-        return k
     for _ in range(MAX_SUBDIVISIONS):
-        short = (theta / k > 2 * np.arctan(width / (k * thickness))) & (k < MAX_SUBDIVISIONS)
+        short = (theta / k > 2 * np.arctan(width / (k * thickness))) & (k < MAX_SUBDIVISIONS) & eq8
         if not short.any():
             break
         k[short] += 1
@@ -68,12 +69,25 @@ def _resolve_widths(pattern, thickness, hinge_width, bend_radius) -> np.ndarray:
     return widths
 
 
-def _resolve_subdivisions(pattern, widths, thickness, subdivisions, exact_arc) -> np.ndarray:
+def _resolve_hinges(pattern, hinge) -> np.ndarray:
+    """(E,) hinge model name per edge ("" for boundary edges), validated."""
+    names = np.broadcast_to(np.asarray(DEFAULT_HINGE if hinge is None else hinge, dtype=object),
+                            (pattern.n_edges,)).copy()
+    names[[n is None for n in names]] = DEFAULT_HINGE
+    bad = [e for e, n in enumerate(names) if n not in HINGE_MODELS]
+    if bad:
+        raise MeshError(f"{pattern.source}: edge {bad[0]}: unknown hinge model "
+                        f"{names[bad[0]]!r} (available: {', '.join(HINGE_MODELS)})")
+    names[pattern.assignments == "B"] = ""
+    return names.astype(str)
+
+
+def _resolve_subdivisions(pattern, widths, thickness, subdivisions, hinges) -> np.ndarray:
     crease = pattern.assignments != "B"
     if subdivisions is None or (isinstance(subdivisions, str) and subdivisions == "auto"):
         k = np.zeros(pattern.n_edges, dtype=np.int64)
         k[crease] = auto_subdivisions(widths[crease], thickness, pattern.max_angles[crease],
-                                      exact_arc)
+                                      hinges[crease])
         return k
     k = np.broadcast_to(np.asarray(subdivisions), (pattern.n_edges,))
     if not np.issubdtype(k.dtype, np.integer) or (k[crease] < 1).any():
@@ -234,7 +248,7 @@ def _attach_strip_sides(pattern, e, lines, corners, corner_ids, table, inserts, 
 
 
 def thicken(pattern: CreasePattern, thickness: float, hinge_width=None,
-            subdivisions="auto", bend_radius: float = 0.0, exact_arc: bool = True,
+            subdivisions="auto", bend_radius: float = 0.0, hinge=None,
             stiffness=None, stretch=None, elastic=None,
             cell_size: float | None = None) -> ThickMesh:
     """Build the thick prism mesh of a crease pattern (paper §2.2).
@@ -252,8 +266,16 @@ def thicken(pattern: CreasePattern, thickness: float, hinge_width=None,
         Sub-strips per hinge; "auto" uses :func:`auto_subdivisions`.
     bend_radius : float
         Inner bend radius r for automatic widths, mm.
-    exact_arc : bool
-        Hinge targets on the exact circular arc (True) or Eq. 8's trapezoids.
+    hinge : {"axis", "arc", "eq8"} or (E,) of them (None entries: default), optional
+        Hinge kinematics: ``"axis"`` (default,
+        :data:`foldcore.hinges.DEFAULT_HINGE`) — the panels turn about the
+        crease's mid-line (rigid-origami kinematics at any thickness) until
+        their inner edges touch, then about their inner edges; ``"arc"`` — the paper's
+        strip bent as a circular arc of constant length (Eq. 7 thickness
+        accommodation; the axis drifts off the crease); ``"eq8"`` — the
+        paper's Eq. 8 trapezoids. Why and what each costs:
+        :mod:`foldcore.hinges`. FOLD files carry it per crease as
+        ``foldcore:edges_hinge``.
     stiffness : dict, optional
         ``{"panel": (F,) or float, "hinge": (E,) or float}`` stiffness factors
         multiplying the volume weights (dimensionless, > 0, default 1). Each
@@ -302,7 +324,8 @@ def thicken(pattern: CreasePattern, thickness: float, hinge_width=None,
                         f"got {thickness}")
     _check_stiffness(pattern, stiffness)
     widths = _resolve_widths(pattern, thickness, hinge_width, bend_radius)
-    ks = _resolve_subdivisions(pattern, widths, thickness, subdivisions, exact_arc)
+    hinges = _resolve_hinges(pattern, hinge)
+    ks = _resolve_subdivisions(pattern, widths, thickness, subdivisions, hinges)
     stretch = _resolve_stretch(pattern, stretch)
     ks[list(stretch)] = 1
     table = _PointTable()
@@ -329,9 +352,9 @@ def thicken(pattern: CreasePattern, thickness: float, hinge_width=None,
     panels, panel_of_face = _panel_group(pattern, points, loops, cells, thickness,
                                          stiff.get("panel", 1.0))
     bending = {e: lines for e, lines in strip_points.items() if e not in stretch}
-    hinges, strips_of = _hinge_group(pattern, points, bending, widths, ks, thickness,
-                                     exact_arc, stiff.get("hinge", 1.0))
-    groups = {"rigid_panel": panels, "bending_hinge": hinges}
+    strips, strips_of = _hinge_group(pattern, points, bending, widths, ks, thickness,
+                                     hinges, stiff.get("hinge", 1.0))
+    groups = {"rigid_panel": panels, "bending_hinge": strips}
     if stretch:
         groups["stretch_hinge"] = _stretch_group(pattern, points, strip_points, stretch,
                                                  widths, thickness, stiff.get("hinge", 1.0))
@@ -339,7 +362,7 @@ def thicken(pattern: CreasePattern, thickness: float, hinge_width=None,
     return ThickMesh(points=points, thickness=float(thickness), groups=groups,
                      panel_of_face=panel_of_face,
                      strips_of_crease=strips_of, hinge_width=widths, subdivisions=ks,
-                     segments=segments, elastic=built)
+                     segments=segments, elastic=built, hinge_model=hinges)
 
 
 def _prism(ids2d, points, thickness):
@@ -664,7 +687,7 @@ def _polygon_area(xy) -> float:
     return 0.5 * float(_cross(xy, np.roll(xy, -1, axis=0)).sum())
 
 
-def _hinge_group(pattern, points, strip_points, widths, ks, thickness, exact_arc, stiffness):
+def _hinge_group(pattern, points, strip_points, widths, ks, thickness, hinges, stiffness):
     """The bending-hinge group: k × m sub-strips per crease (m segments along it),
     built a crease at a time with array operations (a per-strip Python loop took
     ~1.2 s of 2.3 s of ``thicken`` on Miura 50 × 50), and each crease's strip ids."""
@@ -686,9 +709,11 @@ def _hinge_group(pattern, points, strip_points, widths, ks, thickness, exact_arc
         loops.append(np.concatenate([quads, quads + n_top], axis=1))
         rests.append((_prisms(quads, points, thickness) @ _hinge_frame(pattern, e))
                      .reshape(-1, 3))
-        params.append(np.tile(_hinge_params(widths[e] / k, thickness, target, k,
-                                            sign[pattern.assignments[e]],
-                                            pattern.max_angles[e], exact_arc), (k * m, 1)))
+        rows = np.tile(_hinge_params(widths[e] / k, thickness, target, k,
+                                     sign[pattern.assignments[e]], pattern.max_angles[e],
+                                     hinges[e]), (k * m, 1))
+        rows[:, HINGE_PARAMS.index("series")] = np.arange(k * m) % k  # place in its series
+        params.append(rows)
         # per segment, as before: a vectorised norm sums differently (not bit-identical)
         lengths = np.array([float(np.linalg.norm(points[b] - points[a]))
                             for a, b in zip(grid[0, :-1], grid[0, 1:])])
@@ -774,14 +799,15 @@ def _hinge_frame(pattern, e) -> np.ndarray:
                      [0.0 * uy - 0.0 * ux, 1.0, 0.0]])
 
 
-def _hinge_params(width, thickness, target_deg, k, sign, max_deg, exact_arc):
+def _hinge_params(width, thickness, target_deg, k, sign, max_deg, model):
     p = np.zeros(len(HINGE_PARAMS))  # floor stays 0 (set by Simulation)
     p[HINGE_PARAMS.index("width")] = width
     p[HINGE_PARAMS.index("height")] = thickness
     p[HINGE_PARAMS.index("target")] = np.radians(target_deg) / k
     p[HINGE_PARAMS.index("sign")] = sign
     p[HINGE_PARAMS.index("max_angle")] = np.radians(max_deg) / k
-    p[HINGE_PARAMS.index("exact_arc")] = float(exact_arc)
+    p[HINGE_PARAMS.index("model")] = float(HINGE_MODELS.index(model))
+    p[HINGE_PARAMS.index("strips")] = k
     return p
 
 

@@ -31,6 +31,9 @@ foldcore's own keys (lengths in the file's ``frame_unit``; foldcore writes mm):
 * ``foldcore:edges_poisson`` — in a result of a mesh with stretch hinges: per
   edge ``null`` (a bending hinge or boundary) or the stretch hinge's Poisson
   ratio ν, as given to ``thicken(stretch=...)``.
+* ``foldcore:edges_hinge`` — hinge model per edge, ``"axis"``, ``"arc"``,
+  ``"eq8"`` or ``null`` (the default, ``axis``; :mod:`foldcore.hinges`), as
+  given to ``thicken(hinge=...)``; results carry the models used.
 
 Every malformed input raises :class:`PatternError` naming the file and the
 offending item; files above :data:`MAX_FILE_BYTES` are refused unread.
@@ -49,6 +52,7 @@ from functools import partial
 import numpy as np
 
 from ..errors import PatternError
+from ..hinges import HINGE_MODELS
 from ..pattern import DEFAULT_MAX_ANGLE_DEG, CreasePattern
 from ..planar import derive_faces
 
@@ -67,6 +71,7 @@ EDGE_STIFFNESS_KEY = "foldcore:edges_stiffness"
 FACE_STIFFNESS_KEY = "foldcore:faces_stiffness"
 CELLS_KEY = "foldcore:faces_cells"
 POISSON_KEY = "foldcore:edges_poisson"
+HINGE_KEY = "foldcore:edges_hinge"
 #: What a JSON array may be in a FOLD dict: a list, or a tuple from a Python caller.
 ARRAY = (list, tuple)
 
@@ -88,12 +93,16 @@ class FoldFile:
         ``foldcore:edges_stiffness`` / ``foldcore:faces_stiffness``
         (dimensionless, null → 1; see :func:`foldcore.thicken`), ready for
         ``thicken(..., stiffness=...)``; None when the file has neither.
+    hinge : list of str or None, or None
+        Hinge model per edge from ``foldcore:edges_hinge`` (None entries:
+        the default), ready for ``thicken(..., hinge=...)``; None when absent.
     """
 
     pattern: CreasePattern
     thickness: float | None
     frame_unit: str
     stiffness: dict | None = None
+    hinge: list | None = None
 
 
 # ------------------------------------------------------------------- reading
@@ -163,7 +172,7 @@ def fold_file_from_dict(d, source: str = "<fold>") -> FoldFile:
         faces=_faces(d, len(vertices), source), source=source)
     pattern = _build(args)
     return FoldFile(pattern, _thickness(d, scale, source), unit,
-                    _stiffness(d, n, args["faces"], source))
+                    _stiffness(d, n, args["faces"], source), _hinge_models(d, n, source))
 
 
 def read_bytes(path, limit: int | None = None) -> bytes:
@@ -345,6 +354,19 @@ def edges_poisson(d: dict, n_edges: int, source: str) -> dict:
                           f"[-1, 0.5] or null, got {_short(nu)}")
         out[e] = float(nu)
     return out
+
+
+def _hinge_models(d: dict, n_edges: int, source: str) -> list | None:
+    """Hinge model name (or None) per edge from ``foldcore:edges_hinge``."""
+    raw = d.get(HINGE_KEY)
+    if raw is None:
+        return None
+    _check_length(raw, HINGE_KEY, n_edges, source, "edge")
+    for e, name in enumerate(raw):
+        if name is not None and name not in HINGE_MODELS:
+            _fail(source, f"{HINGE_KEY}[{e}] (edge {e}) must be one of "
+                          f"{', '.join(map(repr, HINGE_MODELS))} or null, got {_short(name)}")
+    return list(raw)
 
 
 def _stiffness(d: dict, n_edges: int, faces, source: str) -> dict | None:

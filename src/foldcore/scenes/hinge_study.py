@@ -5,11 +5,15 @@ W = 0.8 mm (Eq. 7 with r ≈ 0: the inner face's vertices coalesce) against
 W = 1 mm, each with k = 2, 4, 8 sub-strips. Panels 5 mm × 5 mm (the paper's
 panel size is not needed: the hinge alone sets the radius).
 
-Each (W, k) is folded twice: with Eq. 8's trapezoid targets (the paper's;
-a sub-strip of width W/k reaches at most 2·atan(W/(kH)), so small k falls
-short) and with exact-arc targets (foldcore's default).
+Each (W, k) is folded with each hinge model (:mod:`foldcore.hinges`):
+Eq. 8's trapezoid targets (the paper's; a sub-strip of width W/k reaches at
+most 2·atan(W/(kH)), so small k falls short), the constant-length arc (the
+paper's Eq. 7 hinge: a flat fold keeps the inner faces 2r apart) and the
+axis hinge (foldcore's default: past θ* = 2·atan(W/H), 116° at W = 0.8 mm,
+the strip pivots about its inner surface, so a flat fold closes the inner
+gap and the panels stack face to face, inner radius 0).
 
-Quantities per (target, W, k): the achieved fold angle and its error against 180°;
+Quantities per (hinge model, W, k): the achieved fold angle and its error against 180°;
 the inner bend radius measured from the folded hinge (circle through the
 k + 1 inner-face vertices at one end of the crease, in the plane normal to
 the crease) beside Eq. 7's r = W/θ − H/2; and the gap between the two
@@ -30,6 +34,7 @@ from ._measure import panel_normal
 THICKNESS = 0.5  # mm
 WIDTHS = (0.8, 1.0)  # mm
 SUBDIVISIONS = (2, 4, 8)
+MODELS = ("eq8", "arc", "axis")  # foldcore.hinges.HINGE_MODELS
 PANEL, DEPTH = 5.0, 5.0  # mm
 ANGLE = 180.0  # degrees
 TOLERANCE = 1e-11
@@ -37,18 +42,18 @@ DEGENERATE_RADIUS = 100.0  # fitted radius / span of the inner points beyond whi
 
 
 def run(quick: bool = False, solver: str | None = None) -> SceneRun:
-    """Fold the hinge for every (target, W, k) (see module docstring); the last is the result."""
+    """Fold the hinge for every (hinge model, W, k) (module docstring); the last is the result."""
     solver = solver or "rigid"
     budget = (100 if quick else 400) if solver == "rigid" else (5_000 if quick else 60_000)
     rows = []
-    for exact_arc, width, k in itertools.product((False, True), WIDTHS, SUBDIVISIONS):
+    for model, width, k in itertools.product(MODELS, WIDTHS, SUBDIVISIONS):
         pattern = single_hinge(panel_length=PANEL, depth=DEPTH, angle=ANGLE, width=width)
-        mesh = thicken(pattern, THICKNESS, subdivisions=k, exact_arc=exact_arc)
+        mesh = thicken(pattern, THICKNESS, subdivisions=k, hinge=model)
         result = Simulation(mesh, pattern, solver=solver).run(tolerance=TOLERANCE,
                                                              max_iterations=budget)
         achieved = float(result.fold_angles_deg[0])
         rows.append({
-            "target": "exact arc" if exact_arc else "Eq. 8", "width_mm": width,
+            "hinge": model, "width_mm": width,
             "subdivisions": k, "fold_angle_deg": round(achieved, 5),
             "angle_error_deg": round(abs((achieved - ANGLE + 180.0) % 360.0 - 180.0), 5),
             "inner_radius_mm": _rounded(inner_radius(mesh, result.positions)),
