@@ -161,3 +161,38 @@ def test_render_option_writes_a_png(fold_file, tmp_path):
     image = iio.imread(png)
     assert image.ndim == 3 and image.shape[0] > 100
     assert (image[..., :3] < 200).any()      # something other than white background
+
+
+def test_report_gives_each_actuated_crease_and_where_the_hinge_model_breaks(tmp_path):
+    """Pehrson's vertex at the paper's size, crease 1 driven to 180° at 50 %: the
+    report's targets are the effective ones (90°), each actuated crease has its
+    target, achieved angle and miss; the hinges section names the model of every
+    crease. Folded fully (100 %) creases pass the axis hinge's pivot angle
+    2·atan(W/H) (157/103/136/103°), are listed as pivoting, the vertex binds and
+    the strips' misfit and the panels' overlap are reported; angle-controlled
+    actuation meets the actuated target where equal weights do not."""
+    pattern = patterns.degree4_vertex(rho1=180.0)
+    src = tmp_path / "d4.fold"
+    write_fold(src, pattern, thickness=3.175)
+    misses = {}
+    for percent, actuation in (("50", "equal"), ("100", "equal"), ("100", "angle")):
+        report = tmp_path / f"{percent}{actuation}.json"
+        assert main(["simulate", str(src), "--fold-percent", percent, "--actuation", actuation,
+                     "--report", str(report), "--subdivisions", "4"]) == 0
+        data = json.loads(report.read_text())
+        (crease,) = data["actuation"]["creases"]
+        assert crease["edge"] == 0 and data["target_angles_deg"][0] == crease["target_deg"]
+        assert crease["target_deg"] == pytest.approx(1.8 * float(percent))
+        assert crease["miss_deg"] == pytest.approx(crease["achieved_deg"] - crease["target_deg"])
+        assert data["hinges"]["model"][:4] == ["axis"] * 4
+        assert data["settings"]["actuation"] == actuation
+        misses[percent, actuation] = abs(crease["miss_deg"])
+        if percent == "50":
+            assert data["hinges"]["pivoting_edges"] == [] and misses["50", "equal"] < 1e-3
+            assert data["hinges"]["largest_misfit_mm"] < 1e-6
+        else:
+            assert set(data["hinges"]["pivoting_edges"]) >= {1, 2, 3}
+            assert data["hinges"]["largest_misfit_mm"] > 1e-3
+            assert data["hinges"]["largest_overlap_mm"] >= 0.0
+    assert misses["100", "angle"] < 0.1 < misses["100", "equal"]
+    assert main(["simulate", str(src), "--branch-floor", "-1"]) == 2

@@ -269,7 +269,7 @@ def test_branch_stage_runs_from_flat_only_and_releases_its_floor():
 def test_angle_actuation_stiffens_the_actuated_strips_only():
     """actuation="angle": actuated strips weigh ACTUATION_STIFFNESS × their volume,
     passive ones their volume; making a crease passive drops its factor."""
-    from foldcore.simulation import ACTUATION_STIFFNESS
+    from foldcore.actuation import ACTUATION_STIFFNESS
 
     pattern = patterns.degree4_vertex(rho1=40.0)
     mesh = thicken(pattern, 2.0)

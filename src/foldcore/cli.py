@@ -21,6 +21,7 @@ import sys
 import warnings
 
 from .hinges import DEFAULT_HINGE, HINGE_MODELS
+from .actuation import ACTUATIONS, BRANCH_FLOOR_DEG, DEFAULT_ACTUATION
 from .strategies import DEFAULT_SOLVER, SOLVERS
 
 EXIT_BAD_INPUT = 2
@@ -52,6 +53,16 @@ def _positive(text: str) -> float:
         raise argparse.ArgumentTypeError(f"expected a number, got {text!r}")
     if not value > 0 or value == float("inf"):
         raise argparse.ArgumentTypeError(f"expected a positive finite number, got {text}")
+    return value
+
+
+def _non_negative(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}")
+    if not 0 <= value < float("inf"):
+        raise argparse.ArgumentTypeError(f"expected a finite number ≥ 0, got {text}")
     return value
 
 
@@ -122,6 +133,15 @@ def build_parser() -> argparse.ArgumentParser:
                           f"the file's foldcore:edges_hinge, else {DEFAULT_HINGE}")
     sim.add_argument("--eq8", dest="hinge", action="store_const", const="eq8",
                      help="same as --hinge eq8")
+    sim.add_argument("--actuation", choices=ACTUATIONS, default=DEFAULT_ACTUATION,
+                     help="equal (an actuated hinge weighs what a passive one does, the "
+                          "paper's) or angle (actuated hinges 1000x stiffer: their angles are "
+                          f"met where the model binds); default {DEFAULT_ACTUATION}")
+    sim.add_argument("--branch-floor", type=_non_negative, default=BRANCH_FLOOR_DEG,
+                     metavar="DEG",
+                     help="from a flat sheet, first fold with passive M/V creases held at "
+                          "least DEG degrees on their assigned side, then release them "
+                          f"(branch selection; 0 turns it off; default {BRANCH_FLOOR_DEG:g})")
     sim.add_argument("-o", "--output", help="write the result as FOLD (achieved angles + "
                                             "folded solid in file_frames)")
     sim.add_argument("--report", help="write the JSON report here")
@@ -220,7 +240,8 @@ def simulate(args) -> int:
         check_output(args.animate)          # a missing encoder fails before any work
     mesh = thicken(pattern, thickness, args.hinge_width, args.subdivisions,
                    hinge=args.hinge or file_hinges, stiffness=stiffness)
-    sim = Simulation(mesh, pattern, solver=args.solver)
+    sim = Simulation(mesh, pattern, solver=args.solver, actuation=args.actuation,
+                     branch_floor_deg=args.branch_floor)
     if args.animate:
         result = _animate(args, sim)
     else:
@@ -233,6 +254,7 @@ def simulate(args) -> int:
     settings = {k: getattr(args, k) for k in ("pattern", "fold_percent", "solver",
                                               "tolerance", "max_iterations", "subdivisions")}
     settings.update(thickness_mm=thickness, hinge=sorted(set(mesh.hinge_model) - {""}),
+                    actuation=args.actuation, branch_floor_deg=args.branch_floor,
                     backend=sim.system.factor.backend)
     write_result(result, pattern, mesh, thickness, settings, fold=args.output,
                  report=args.report, png=args.render)

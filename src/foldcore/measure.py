@@ -56,3 +56,64 @@ def dihedral_deg(n_left: np.ndarray, n_right: np.ndarray, d: np.ndarray) -> np.n
     d_hat = d / np.linalg.norm(d, axis=1)[:, None]
     sin = np.einsum("ni,ni->n", np.cross(n_right, n_left), d_hat)
     return np.degrees(np.arctan2(sin, np.einsum("ni,ni->n", n_left, n_right)))
+
+
+def crease_overlaps(pattern, mesh, positions: np.ndarray) -> np.ndarray:
+    """(E,) how deep (mm) the two panels of each crease pass into each other; NaN on B.
+
+    For each crease and each ordering (A, B) of its panels: the vertices B shares
+    with the crease's hinge strips (its hinge edge, top and bottom) are tested
+    against A's slab — inside it (closer to A's mid-plane than H/2) and over A
+    (on A's side of A's hinge edge, in A's plane) means B's edge is inside A,
+    by its distance to A's face on the fold's inner side. The deepest of either
+    ordering is the crease's overlap (0: the panels at most touch). Local to
+    each crease: panels that meet elsewhere (far collisions) are not looked at.
+    """
+    panels = mesh.groups[mesh.panel_group]
+    strips = mesh.groups.get("bending_hinge")
+    rot = element_rotations(panels, positions)
+    half = 0.5 * mesh.thickness
+    out = np.full(pattern.n_edges, np.nan)
+    for e in pattern.creases:
+        e = int(e)
+        pair = [int(mesh.panel_of_face[f]) for f in pattern.edge_faces[e]]
+        ids = [panels.indices[panels.slots(p)] for p in pair]
+        own = np.zeros(0, dtype=np.int64)
+        if strips is not None and e in mesh.strips_of_crease:
+            own = np.concatenate([strips.indices[strips.slots(int(s))]
+                                  for s in mesh.strips_of_crease[e]])
+        edge = [i[np.isin(i, own)] for i in ids]
+        if not all(len(x) for x in edge):
+            out[e] = 0.0
+            continue
+        depth = 0.0
+        for a, b in ((0, 1), (1, 0)):
+            depth = max(depth, _depth_into(positions, ids[a], edge[a], rot[pair[a]],
+                                           positions[edge[b]], half))
+        out[e] = depth
+    return out
+
+
+def _depth_into(positions, panel_ids, hinge_ids, rotation, points, half) -> float:
+    """Deepest of ``points`` (n, 3) mm inside the slab of one panel (vertex ids
+    ``panel_ids``, hinge-edge vertex ids ``hinge_ids``, best-fit rotation) and over
+    it — past its hinge edge toward its centre, within the edge's span; 0 when
+    none is."""
+    normal = rotation[:, 2]
+    centre = positions[panel_ids].mean(axis=0)
+    edge = positions[hinge_ids]
+    along = edge[np.argmax(np.linalg.norm(edge - edge[0], axis=1))] - edge[0]
+    along -= (along @ normal) * normal
+    along /= np.linalg.norm(along)
+    start = edge.mean(axis=0)
+    inward = centre - start
+    inward -= (inward @ normal) * normal + (inward @ along) * along
+    inward /= np.linalg.norm(inward)
+    span = (edge - start) @ along
+    height = (points - centre) @ normal
+    reach = (points - start) @ along
+    chosen = ((points - start) @ inward > 0.0) & (np.abs(height) < half) \
+        & (reach >= span.min()) & (reach <= span.max())
+    if not chosen.any():
+        return 0.0
+    return float((half - np.abs(height[chosen])).max())

@@ -45,6 +45,54 @@ def _iteration_cost(result) -> dict:
             if t["bare_solve"] > 0 else None}
 
 
+def wrapped_deg(angles) -> np.ndarray:
+    """Angle differences (degrees) wrapped into [−180, 180)."""
+    return (np.asarray(angles, dtype=float) + 180.0) % 360.0 - 180.0
+
+
+def actuation_entries(result, pattern) -> dict:
+    """Per actuated crease: effective target, achieved angle and miss (degrees)."""
+    targets = result.target_angles_deg if result.target_angles_deg is not None \
+        else np.array(pattern.fold_angles, dtype=float)
+    driven = np.flatnonzero(np.isfinite(targets))
+    miss = wrapped_deg(result.fold_angles_deg[driven] - targets[driven])
+    creases = [{"edge": int(e), "target_deg": float(t), "achieved_deg": float(a),
+                "miss_deg": float(m)}
+               for e, t, a, m in zip(driven, targets[driven], result.fold_angles_deg[driven],
+                                     miss)]
+    worst = float(np.abs(miss).max()) if len(miss) else 0.0
+    return {"creases": creases, "largest_miss_deg": worst,
+            "median_miss_deg": float(np.median(np.abs(miss))) if len(miss) else 0.0}
+
+
+def hinge_entries(result, pattern, mesh) -> dict:
+    """Where the hinge model's idealisation breaks, with numbers: creases past the
+    axis hinge's pivot angle (binding there), the panels' largest interpenetration
+    at a crease (mm), the strips' largest misfit to their model shape (mm) and the
+    largest surface strain (dimensionless)."""
+    from .hinges import pivot_angle_deg
+    from .measure import crease_overlaps
+
+    models = mesh.hinge_model if mesh.hinge_model is not None else np.full(pattern.n_edges, "")
+    angles = np.abs(result.fold_angles_deg)
+    pivot = np.where(models == "axis", pivot_angle_deg(mesh.hinge_width, mesh.thickness),
+                     np.nan)
+    pivoting = np.flatnonzero(np.nan_to_num(angles - pivot, nan=-1.0) > 0)
+    overlap = crease_overlaps(pattern, mesh, result.positions)
+    out = {"model": [str(m) if m else None for m in models],
+           "pivot_angle_deg": _nullable(pivot), "pivoting_edges": pivoting.tolist(),
+           "largest_overlap_mm": float(np.nanmax(overlap, initial=0.0)),
+           "overlap_mm": _nullable(overlap)}
+    misfit = result.hinge_misfit_mm
+    if misfit is not None and len(misfit):
+        worst = int(np.argmax(misfit))
+        out.update(largest_misfit_mm=float(misfit[worst]),
+                   largest_misfit_edge=int(mesh.groups["bending_hinge"].source[worst]))
+    if result.strip_strains is not None and len(result.strip_strains):
+        out["largest_strip_strain"] = float(np.abs(result.strip_strains).max())
+    return out
+
+
 def report_dict(result, pattern, mesh, settings: dict, quantities: dict | None = None) -> dict:
     """The JSON report of a run (contract in DESIGN.md), plus the settings used.
 
@@ -62,7 +110,11 @@ def report_dict(result, pattern, mesh, settings: dict, quantities: dict | None =
         "energy": float(energy[-1]) if len(energy) else 0.0,
         "energy_history": energy.tolist(),
         "fold_angles_deg": _nullable(result.fold_angles_deg),
-        "target_angles_deg": _nullable(pattern.fold_angles),
+        "target_angles_deg": _nullable(result.target_angles_deg
+                                       if result.target_angles_deg is not None
+                                       else pattern.fold_angles),
+        "actuation": actuation_entries(result, pattern),
+        "hinges": hinge_entries(result, pattern, mesh),
         "strip_angles_deg": result.strip_angles_deg.tolist(),
         **_strain_entries(result),
         "vertices": int(mesh.n_vertices),

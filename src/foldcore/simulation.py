@@ -13,6 +13,8 @@ import numpy as np
 import elements
 from elements.bending_hinge import FLOOR, SIGN, TARGET, limit_excess
 from . import strategies
+from .actuation import (ACTUATION_STIFFNESS, ACTUATIONS, BRANCH_FLOOR_DEG, BRANCH_TOLERANCE,
+                        DEFAULT_ACTUATION)
 from .errors import SimulationError
 from .measure import fold_angles
 from .strategies import DEFAULT_SOLVER
@@ -26,11 +28,6 @@ STOP_LEAVE = 1e-3  # rad back inside its interval before a stop is released
 # 2-core Xeon, paper map, ms/iteration 1 vs 2 threads: Miura 2×2 (108 slots) 0.070 vs
 # 0.063 quiet / 2.3 with the cores busy; 5×5 (936) 0.41 vs 0.28; 10×10 (4 076) 1.77 vs 1.09.
 SERIAL_BELOW_SLOTS = 500
-ACTUATION_STIFFNESS = 1e3  # weight multiplier of actuated strips under actuation="angle"
-ACTUATIONS = ("angle", "equal")
-BRANCH_FLOOR_DEG = 2.0  # default floor of the branch stage (Simulation.branch_floor_deg)
-BRANCH_TOLERANCE = 1e-6  # relative step at which the branch stage hands over
-DEFAULT_ACTUATION = "equal"  # why: the Simulation docstring (actuation)
 BARE_SOLVE_REPEATS = 5  # solves timed for the per-iteration cost floor
 
 
@@ -71,6 +68,12 @@ class Result:
         sub-strip from its current shape (:mod:`foldcore.strain`), dimensionless
     failures : list of dict, hinges that exceeded their strain limits (first
         iteration each; empty without ``strain_limits``)
+    target_angles_deg : (E,) float, the effective target of each crease at the
+        run's fold percent (NaN: passive or boundary)
+    hinge_misfit_mm : (S,) float, how far each hinge sub-strip is from its own
+        model shape: the RMS distance (mm) of its vertices from its rotated
+        target at ``positions`` — 0 where the hinge model is met, > 0 where
+        the model binds (a vertex that cannot close, conflicting targets)
     """
 
     positions: np.ndarray
@@ -82,6 +85,8 @@ class Result:
     timings_s: dict = field(default_factory=dict)
     strip_strains: np.ndarray | None = None
     failures: list = field(default_factory=list)
+    target_angles_deg: np.ndarray | None = None
+    hinge_misfit_mm: np.ndarray | None = None
 
 
 class _GroupRun:
@@ -134,12 +139,11 @@ class Simulation:
     solver : {"hybrid", "lbfgs", "paper", "anderson", "rigid"} or a registered name
         Iteration strategy (one module each in :mod:`foldcore.strategies`),
         default ``"hybrid"`` (why: :data:`foldcore.strategies.DEFAULT_SOLVER`):
-        each ``run`` starts with up to 200 ``"rigid"`` steps and continues
-        with ``"lbfgs"`` from where they stop (bare :meth:`step` calls are
-        L-BFGS steps; a mesh the rigid strategy cannot take runs L-BFGS
-        alone). Its rigid phase reaches position targets within a few
-        iterations, before a ``decay`` < 1 (counted in iterations) has faded
-        them: for a pull-and-release schedule use ``"lbfgs"`` or ``"paper"``.
+        each ``run`` starts with ``"rigid"`` steps, ends there if they meet
+        the tolerance, else continues with ``"lbfgs"`` from where they stop
+        (bare :meth:`step` calls are L-BFGS steps; a mesh the rigid strategy
+        cannot take runs L-BFGS alone, as does a run with a fading position
+        target, ``decay`` < 1).
         ``energy_history`` joins the rigid phase's energy and the paper's.
         ``"paper"``: the paper's plain local/global map (every element a soft
         spring; iterations grow with panel length / thickness).
@@ -159,10 +163,11 @@ class Simulation:
         Fold magnitude (degrees per crease) a passive M/V hinge is given when
         its estimate has the wrong sign (§4.2 "a small value"); default 0.
     branch_floor_deg : float
-        Branch selection by assignment (degrees, ≥ 0; 0 turns it off): a run
-        that starts from a flat sheet with some crease driven first folds with
-        every passive M/V crease held at least this far on its assigned side,
-        then releases them (:meth:`run`). Default ``BRANCH_FLOOR_DEG`` (2°).
+        Branch selection by assignment (degrees, ≥ 0; 0 turns it off;
+        :mod:`foldcore.actuation`): a run that starts from a flat sheet with
+        some crease driven first folds with every passive M/V crease held at
+        least this far on its assigned side, then releases them (:meth:`run`).
+        Default ``BRANCH_FLOOR_DEG`` (2°).
     stop_stiffness : float
         Weight multiplier (dimensionless, ≥ 1) of a passive sub-strip bent
         past its max angle by more than ``STOP_ENTER``: the joint closes and
@@ -184,18 +189,11 @@ class Simulation:
         :meth:`result`): sweep ``set_fold_percent`` to locate a first
         failure along a path.
     actuation : {"equal", "angle"}
-        What an actuated crease is. ``"equal"`` (default, the paper's): an
-        actuated strip weighs what a passive one does (a hinge with a rest
-        angle), so where the model cannot meet every target at once (binding
-        vertices, conflicting targets, position targets) the actuated creases
-        share the misfit. ``"angle"``: angle-controlled — its strips weigh
-        ``ACTUATION_STIFFNESS`` (10³) times their volume, as if a stiff
-        actuator held the angle, so the passive creases and panels give way
-        and the actuated angles are reached. Where every target can be met
-        both give the same state. Why ``"equal"`` is the default (measured,
-        bench/accuracy): with the axis hinge both reach the closed forms, and
-        the stiffness contrast of ``"angle"`` slows L-BFGS and can stall the
-        rigid strategy (a thin mode-B vertex stopped at 12.7° of 60°).
+        What an actuated crease is (:mod:`foldcore.actuation`): ``"equal"``
+        (default, the paper's) — an actuated strip weighs what a passive one
+        does, so where the model binds the actuated creases share the
+        misfit; ``"angle"`` — actuated strips ``ACTUATION_STIFFNESS`` (10³)
+        times stiffer, so their angles are met and the rest gives way.
     threads : int, optional
         numba threads for the kernels of this simulation (set at each step,
         so simulations in one process do not override each other). Default:
@@ -501,10 +499,8 @@ class Simulation:
     def _branch_stage(self, budget: int, callback, limit: float) -> tuple[int, float, bool]:
         """Fold from flat with every passive M/V crease held at least
         ``branch_floor_deg`` on its assigned side, to ``BRANCH_TOLERANCE`` (or the
-        run's, if looser), then release the floor to the user's: the flat state is
-        a bifurcation, and the floor puts the sheet on the branch its assignment
-        names before the passive creases are free (thick Miura 10 × 10 with one
-        crease driven: jammed 60° short without it, exact with it; bench/accuracy)."""
+        run's, if looser), then release the floor to the user's (why:
+        :mod:`foldcore.actuation`)."""
         floor = self._passive_floor_deg
         self._set_floor(max(floor, self.branch_floor_deg))
         self._targets_changed()
@@ -597,7 +593,28 @@ class Simulation:
         return Result(self.x.copy(), self.fold_angles(), self.strip_angles(),
                       np.array(self.energy_history), self.iterations, converged, timings,
                       self.strip_strains(),
-                      list(self._monitor.failures) if self._monitor is not None else [])
+                      list(self._monitor.failures) if self._monitor is not None else [],
+                      self.target_angles(), self.hinge_misfits())
+
+    def target_angles(self) -> np.ndarray:
+        """(E,) effective target of every crease in degrees (valley > 0): its fold
+        angle × the fold percent; NaN for passive creases and boundary edges."""
+        out = self._fold_targets * self._percent / 100.0
+        out[self.pattern.assignments == "B"] = np.nan
+        return out
+
+    def hinge_misfits(self) -> np.ndarray:
+        """(S,) RMS distance (mm) of each hinge sub-strip's vertices from its rotated
+        model shape at the current positions (a fresh projection into scratch
+        arrays: the simulation's own state is untouched)."""
+        if self._hinges is None:
+            return np.zeros(0)
+        run = self._hinges
+        g = run.group
+        residual = np.zeros(len(g))
+        run.etype.batch(self.x, g.indptr, g.indices, g.rest, run.params, np.zeros_like(g.rest),
+                        residual, np.zeros_like(run.state))
+        return np.sqrt(np.maximum(residual, 0.0) / np.diff(g.indptr))
 
     # --------------------------------------------------------------- private
     def _targets_changed(self) -> None:

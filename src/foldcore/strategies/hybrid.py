@@ -1,12 +1,21 @@
-"""``hybrid``: rigid-body steps first, then L-BFGS on the paper's energy (a composite).
+"""``hybrid``: rigid-body steps first, L-BFGS where they cannot finish (a composite).
 
 Each :meth:`Simulation.run` starts with a rigid phase (:mod:`.rigid`) from
-the current positions, until a step moves ≤ max(tolerance,
-``HYBRID_RIGID_TOL``) × size or ``HYBRID_RIGID_MAX`` steps were taken; then
-:mod:`.lbfgs` continues from where it stopped, so the run ends on the
-paper's own energy (Eq. 9 passive hinges, every element type). A mesh the
-rigid phase cannot take (elastic cells, other element types) runs L-BFGS
-alone. Bare :meth:`Simulation.step` calls outside a run are L-BFGS steps;
+the current positions. A rigid step that moves ≤ the run's tolerance ×
+size ends the run there: the rigid-body model's equilibrium (panels exactly
+rigid, each passive crease one bounded bend). Otherwise the phase ends when
+a step moves ≤ ``HYBRID_RIGID_TOL`` × size (a run with a tighter tolerance,
+e.g. 0) or after ``HYBRID_RIGID_MAX`` steps, and :mod:`.lbfgs` continues
+from where it stopped on the paper's own energy (Eq. 9 passive sub-strips,
+panels as stiff elements). Why the run ends with the rigid phase when it
+settles (measured, issue 16): where the rigid phase converges the L-BFGS
+phase only changes the state within the tolerance on compatible scenes, and
+under angle-controlled actuation its 10³ stiffness contrast kept it from
+converging at all (Pehrson's vertex folded flat: rigid 21 iterations, then
+L-BFGS 10 000 without converging). A mesh the rigid phase cannot take
+(elastic cells, other element types) runs L-BFGS alone, and so does a run
+with a fading position target (``decay`` < 1, counted in iterations: the
+rigid phase would settle on the pull before it fades). Bare :meth:`Simulation.step` calls outside a run are L-BFGS steps;
 whatever ends a rigid phase (its criterion, the budget, an exception or an
 interrupt), the strategy is left in its L-BFGS phase. Changed targets start
 the next run with a rigid phase again; positions set from outside are
@@ -45,6 +54,8 @@ class Hybrid(Strategy):
         if not self._pending:
             return
         self._pending = False
+        if any(t.decay < 1.0 for t in self.sim._position_targets.values()):
+            return  # a pull-and-release schedule: the rigid phase would settle before it fades
         try:
             self.rigid = Rigid(self.sim)
         except SimulationError:
@@ -60,10 +71,11 @@ class Hybrid(Strategy):
     def settled(self, moved: float, limit: float) -> bool:
         if self.rigid is None:
             return moved <= limit
+        done = moved <= limit
         floor = HYBRID_RIGID_TOL * self.sim.length_scale
-        if moved <= max(limit, floor) or self._rigid_steps >= HYBRID_RIGID_MAX:
+        if done or moved <= floor or self._rigid_steps >= HYBRID_RIGID_MAX:
             self._leave_rigid_phase()
-        return False
+        return done
 
     def end_run(self) -> None:
         self._leave_rigid_phase()

@@ -1,0 +1,37 @@
+"""Actuation semantics: what an actuated crease is, and how a fold leaves the flat state.
+
+Kept free of heavy imports (the command line reads these names).
+
+**Actuated creases** (``Simulation(actuation=...)``, ``--actuation``):
+
+* ``"equal"`` (default, the paper's): an actuated sub-strip weighs what a
+  passive one does — a hinge with a rest angle. Where the model cannot meet
+  every target at once (a binding vertex, conflicting targets, position
+  targets) the actuated creases share the misfit with the rest.
+* ``"angle"``: angle-controlled — actuated strips weigh ``ACTUATION_STIFFNESS``
+  times their volume, as if a stiff actuator held each angle, so the passive
+  creases and the panels give way and the actuated angles are reached.
+
+Where every target can be met (the axis hinge on a rigid-foldable pattern)
+both reach the same state. Why ``"equal"`` is the default (measured,
+bench/accuracy): with the axis hinge both meet the closed forms, while the
+10³ stiffness contrast of ``"angle"`` slows L-BFGS and can stall the
+rigid-body strategy (a thin mode-B vertex, 150/60/30/120, stopped at 12.7°
+of a 60° target under ``rigid``; ``hybrid`` recovered it).
+
+**Branch selection by assignment** (``branch_floor_deg``, ``--branch-floor``):
+the flat state is a bifurcation — a degree-4 vertex has two branches, a
+Miura sheet many first-order flexes — so a fold driven from flat can jam or
+take the wrong branch. A run that starts from a flat sheet (every crease
+within the floor of 0°) with a crease driven and passive M/V creases first
+folds with every passive M/V crease held at least ``BRANCH_FLOOR_DEG`` on its
+assigned side, to a relative step of ``BRANCH_TOLERANCE``, then releases the
+floor and runs to its own tolerance. Measured: a thick Miura 10 × 10
+(H = 0.1 a, W = H) with one crease driven jammed 60° short without it and
+folds exactly with it; from a folded state there is no such stage.
+"""
+ACTUATIONS = ("equal", "angle")
+DEFAULT_ACTUATION = "equal"
+ACTUATION_STIFFNESS = 1e3  # weight multiplier of actuated strips under "angle"
+BRANCH_FLOOR_DEG = 2.0  # degrees, default floor of the branch stage
+BRANCH_TOLERANCE = 1e-6  # relative step at which the branch stage hands over
