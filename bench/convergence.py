@@ -1,6 +1,7 @@
 """Error vs iterations and vs wall time, per strategy, on the convergence scenes.
 
-Scenes (H, W, k in mm / count; exact-arc targets):
+Scenes (H, W, k in mm / count; the library's defaults otherwise: axis hinge,
+equal-weight actuation, branch stage from flat):
 
 * ``hinge_LpH{5,20,80,320}``: one hinge (H = 1, W = 2, k = 4, crease 10 long)
   between panels Lp long, target 90°. Error = |ρ − 90°| (a compatible
@@ -21,10 +22,11 @@ Scenes (H, W, k in mm / count; exact-arc targets):
   kinematics.miura_angles at facet tilt 30°.
 
 The rigid strategy stops at a step ≤ 1e-10 × extent; ``hybrid`` (the
-default: rigid steps until they stop, then L-BFGS) and the local/global
-strategies run their whole budget (tolerance 0), because its step-size rule stops it early
-on slow scenes (on the thin vertex it "converges" after 40 iterations with
-60° left, measured). Time = the strategy's own time (setup + projection + solve from
+default: rigid steps, which end the run once they meet its tolerance, else
+L-BFGS) and the local/global strategies run their whole budget (tolerance
+0, so hybrid's L-BFGS phase follows once its rigid steps stop moving),
+because the step-size rule stops slow strategies early (on the thin vertex
+L-BFGS "converged" after 40 iterations with 60° left, measured). Time = the strategy's own time (setup + projection + solve from
 ``Simulation.timings``), so measuring the error in the callback does not
 count. The local/global strategies run once per scene (budget per scene in
 SCENES: 20 000 iterations, fewer on the Miura sheets); the rigid strategy's

@@ -203,3 +203,18 @@ def test_grid():
     assert (cp.n_vertices, cp.n_edges, len(cp.faces)) == (12, 17, 6)
     assert np.isclose(cp.area(), 150.0)
     assert np.count_nonzero(cp.assignments == "U") == 7
+
+
+def test_single_vertex_of_degree_five_and_its_refusals():
+    pattern = p.single_vertex((120.0, 90.0, 30.0, 30.0, 90.0), list("VVVMV"),
+                              [60.0, 60.0, None, None, None], radius=10.0)
+    assert pattern.assignments[:5].tolist() == list("VVVMV")
+    assert len(pattern.faces) == 5 and pattern.fold_angles[0] == 60.0
+    starts = np.degrees(np.arctan2(pattern.vertices[1:6, 1], pattern.vertices[1:6, 0])) % 360
+    np.testing.assert_allclose(starts, [0.0, 120.0, 210.0, 240.0, 270.0], atol=1e-9)
+    with pytest.raises(PatternError, match="single_vertex: .* sum to 350"):
+        p.single_vertex((120.0, 90.0, 30.0, 20.0, 90.0), list("VVVMV"))
+    with pytest.raises(PatternError, match="4 assignments for 5 creases"):
+        p.single_vertex((120.0, 90.0, 30.0, 30.0, 90.0), list("VVVM"))
+    with pytest.raises(PatternError, match="at least 3"):
+        p.single_vertex((180.0, 180.0), list("VV"))

@@ -101,12 +101,7 @@ def single_vertex(sectors, assignments, fold_angles=None, radius: float = 50.0,
     sectors = np.asarray(sectors, dtype=float)
     if sectors.ndim != 1 or len(sectors) < 3:
         raise PatternError(f"single_vertex: need at least 3 sector angles, got {sectors.size}")
-    if not (np.all(sectors > 0) and np.all(sectors < 180)):
-        raise PatternError(f"single_vertex: sector angles {sectors.tolist()}° must each be "
-                           "in (0, 180)")
-    if abs(sectors.sum() - 360.0) > _TOL:
-        raise PatternError(f"single_vertex: sector angles {sectors.tolist()}° sum to "
-                           f"{sectors.sum():g}°, not 360°")
+    _check_sector_angles(sectors, "single_vertex")
     if len(assignments) != len(sectors):
         raise PatternError(f"single_vertex: {len(assignments)} assignments for "
                            f"{len(sectors)} creases")
@@ -154,16 +149,20 @@ def _check_sectors(sectors, flat_foldable: bool) -> np.ndarray:
     s = np.asarray(sectors, dtype=float)
     if s.shape != (4,):
         raise PatternError(f"degree4_vertex: need 4 sector angles, got {s.size}")
-    if not (np.all(s > 0) and np.all(s < 180)):
-        raise PatternError(f"degree4_vertex: sector angles {s.tolist()}° must each be "
-                           "in (0, 180)")
-    if abs(s.sum() - 360.0) > _TOL:
-        raise PatternError(f"degree4_vertex: sector angles {s.tolist()}° sum to "
-                           f"{s.sum():g}°, not 360°")
+    _check_sector_angles(s, "degree4_vertex")
     if flat_foldable and (abs(s[0] + s[2] - 180.0) > _TOL or abs(s[1] + s[3] - 180) > _TOL):
         raise PatternError(f"degree4_vertex: sectors {s.tolist()}° are not flat-foldable "
                            "(need α1 + α3 = α2 + α4 = 180°); pass flat_foldable=False")
     return s
+
+
+def _check_sector_angles(s: np.ndarray, where: str) -> None:
+    """Each sector in (0, 180)°, all of them summing to 360°."""
+    if not (np.all(s > 0) and np.all(s < 180)):
+        raise PatternError(f"{where}: sector angles {s.tolist()}° must each be in (0, 180)")
+    if abs(s.sum() - 360.0) > _TOL:
+        raise PatternError(f"{where}: sector angles {s.tolist()}° sum to {s.sum():g}°, "
+                           "not 360°")
 
 
 def _disc_vertices(sectors: np.ndarray, radius: float) -> tuple[np.ndarray, list[int]]:

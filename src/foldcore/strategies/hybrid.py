@@ -30,7 +30,7 @@ from . import Strategy
 from .lbfgs import Lbfgs
 from .rigid import Rigid
 
-HYBRID_RIGID_MAX = 200    # rigid-body steps at most per run
+HYBRID_RIGID_MAX = 1_000  # rigid-body steps at most per run (Miura 20 × 20, one crease driven: 206)
 HYBRID_RIGID_TOL = 1e-10  # relative step below which the rigid phase ends (even at tolerance 0)
 
 
