@@ -21,22 +21,24 @@ equal-weight actuation, branch stage from flat):
   actuated to 60°, the rest passive; error = max over all creases vs
   kinematics.miura_angles at facet tilt 30°.
 
-The rigid strategy stops at a step ≤ 1e-10 × extent; ``hybrid`` (the
-default: rigid steps, which end the run once they meet its tolerance, else
-L-BFGS) and the local/global strategies run their whole budget (tolerance
-0, so hybrid's L-BFGS phase follows once its rigid steps stop moving),
-because the step-size rule stops slow strategies early (on the thin vertex
-L-BFGS "converged" after 40 iterations with 60° left, measured). Time = the strategy's own time (setup + projection + solve from
-``Simulation.timings``), so measuring the error in the callback does not
-count. The local/global strategies run once per scene (budget per scene in
-SCENES: 20 000 iterations, fewer on the Miura sheets); the rigid strategy's
-curve is the median-time run of RUNS runs (budget 200).
-Writes bench/results/convergence.json and .png.
+The rigid strategy and ``hybrid`` (the default: rigid steps, which end the
+run once they meet its tolerance, else L-BFGS) stop at a step ≤ 1e-10 ×
+extent, as a run at the default tolerance would end; the local/global
+strategies run their whole budget (tolerance 0), because the step-size rule
+stops slow strategies early (on the thin vertex L-BFGS "converged" after 40
+iterations with 60° left, measured). Time = the strategy's own time (setup
++ projection + solve from ``Simulation.timings``), so measuring the error in
+the callback does not count. Budget per scene in SCENES (20 000
+iterations, fewer on the Miura sheets; rigid: 200); the rigid and hybrid
+curves are the median-time run of RUNS runs, the others one run.
+Writes bench/results/convergence.json and .png; ``--table`` prints the
+README's table from the JSON.
 """
 from __future__ import annotations
 
 import json
 import statistics
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -127,7 +129,7 @@ def trace(scene, solver: str, budget: int, every: int = 1):
             return err > FLOOR_DEG
         return None
 
-    tolerance = 1e-10 if solver == "rigid" else 0.0
+    tolerance = 1e-10 if solver in ("rigid", "hybrid") else 0.0
     result = sim.run(tolerance=tolerance, max_iterations=budget, callback=record)
     return points, result, sim
 
@@ -142,9 +144,10 @@ def first_below(points, threshold):
 def measure_scene(name, make, budget):
     rows = {}
     for solver in SOLVERS:
-        runs = RUNS if solver == "rigid" else 1
+        rigid_like = solver in ("rigid", "hybrid")
+        runs = RUNS if rigid_like else 1
         traces = [trace(make(), solver, RIGID_BUDGET if solver == "rigid" else budget,
-                        every=1 if solver == "rigid" else 20)
+                        every=1 if rigid_like else 20)
                   for _ in range(runs)]
         totals = [tr[0][-1][1] for tr in traces]
         points, result, sim = traces[int(np.argsort(totals)[len(totals) // 2])]
@@ -226,5 +229,23 @@ def main() -> None:
     plot(data, RESULTS / "convergence.png")
 
 
+def table(path: Path = RESULTS / "convergence.json") -> str:
+    """Markdown: per scene and strategy, iterations (strategy seconds) to 0.01°, or
+    'never' with the final error."""
+    scenes = json.loads(path.read_text())["scenes"]
+    lines = ["| scene | " + " | ".join(SOLVERS) + " |", "|" + "---|" * (len(SOLVERS) + 1)]
+    for name, rows in scenes.items():
+        cells = []
+        for solver in SOLVERS:
+            hit = rows[solver]["to_threshold"]["0.01"]
+            cells.append(f"{hit['iterations']} ({hit['seconds']:.2g} s)" if hit else
+                         f"never ({rows[solver]['final_error_deg']:.3g}°)")
+        lines.append(f"| {name} | " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
 if __name__ == "__main__":
-    main()
+    if "--table" in sys.argv[1:]:
+        print(table())
+    else:
+        main()

@@ -12,29 +12,32 @@ decides whether thick vertices can fold at all. Three models
     rotation by θ about the crease's mid-line (chord W·cos(θ/2), same
     directions), so the panels move as in rigid origami at any thickness:
     the hinge axes of a vertex meet at the vertex and every rigid-foldable
-    pattern folds without strain. Measured (bench/accuracy): degree-4
-    vertices on both branches, a degree-5 corner and Miura sheets, thin and
-    thick, land within 1e-6° of the closed forms. The price is that the
+    pattern folds without strain. Measured (bench/accuracy,
+    tests/test_accuracy): degree-4 vertices on both branches, a degree-5
+    corner and Miura sheets up to 20 × 20, thin and thick, land within 5e-7°
+    of the closed forms. The price is that the
     strip shortens as it bends (1 − f: 21 % at 90°), and that f → 0 at 180°,
     where flat-folded panels would share their mid-line and overlap by H.
     So the neutral axis is never shorter than H·|φ|/2, the length at which
     the strip's inner surface has radius 0: from θ* = 2·atan(W/H) on —
     exactly where the panels' inner edges touch (tan(θ*/2) = W/H) — the
     strip pivots about its inner surface instead, and flat panels stack H
-    apart, face to face, without overlapping. Past θ* the axis leaves the
-    mid-line again (by up to (H/2)·tan(θ/2) − W/2), so a vertex whose
-    creases fold past their θ* binds like the arc model does; the report
-    says which creases are there (``pivoting``) and how far the strips miss
-    their shapes (``hinge_misfit_mm``).
+    apart, face to face, without overlapping. Past θ* the panels turn about
+    their touching inner edges, a line off the crease's mid-line (the
+    equivalent axis sits (H/2)·tan(θ/2) from each panel's edge instead of
+    W/2), so a vertex whose creases fold past their θ* binds like the arc
+    model does: the report lists those creases (``hinges.pivoting_edges``)
+    and how far the strips miss their shapes (``hinges.largest_misfit_mm``).
+    Measured: Pehrson's vertex at W/H = 0.3 (θ* = 33°) driven to 70° misses
+    by 2.7°; at the paper's size folded flat it stops at 162/135/161/−135°.
 
 ``"arc"`` — the paper's hinge (§4, Eq. 7): a circular arc of constant
     neutral-axis length W. It keeps flat panels 2(r + H/2) apart (thickness
     accommodation) but turns the panels about an axis that drifts off the
     crease (≈ W·θ²/12 at small θ, 0.12 W at 70°), so the hinges around a
     vertex do not meet and every closed loop must strain to fold: Pehrson's
-    vertex, mode A, crease 1 to 70°, ends 0.8/5.4/20.8/36.8° short at
-    W/H = 1/3/10/30, at any H (issue 16's measurements); mode B does not
-    leave the flat state.
+    vertex, mode A, crease 1 to 70°, ends 0.8/5.4/21/37° short at
+    W/H = 1/3/10/30 (bench/accuracy; the same at any H), mode B 30–110°.
 
 ``"eq8"`` — the paper's Eq. 8 trapezoid: the arc's linear approximation
     (end faces sheared, error O(φ²)), with the arc's drift.
