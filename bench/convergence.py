@@ -37,6 +37,7 @@ README's table from the JSON.
 from __future__ import annotations
 
 import json
+import os
 import statistics
 import sys
 from pathlib import Path
@@ -47,6 +48,7 @@ from foldcore import kinematics, patterns, thicken
 from foldcore.simulation import Simulation
 
 from _meta import machine_meta
+from scaling import others_busy
 
 RESULTS = Path(__file__).parent / "results"
 RUNS = 3
@@ -215,6 +217,7 @@ def main() -> None:
     trace(hinge_scene(5.0), "rigid", 5)  # warm-up: numba cache load, first factorisation
     for solver in ("paper", "anderson", "lbfgs"):
         trace(hinge_scene(5.0), solver, 5)
+    load, busy = [os.getloadavg()[0]], others_busy()
     data = {}
     for name, (make, budget) in SCENES.items():
         data[name] = measure_scene(name, make, budget)
@@ -224,7 +227,8 @@ def main() -> None:
     RESULTS.mkdir(exist_ok=True)
     meta = {**machine_meta(), "runs_rigid": RUNS, "runs_local_global": 1,
             "tolerance": {"rigid": 1e-10, "local_global": 0.0, "stop_below_deg": FLOOR_DEG},
-            "budget_rigid": RIGID_BUDGET}
+            "budget_rigid": RIGID_BUDGET, "others_busy_before": busy,
+            "load_average_1min": load + [os.getloadavg()[0]]}
     (RESULTS / "convergence.json").write_text(json.dumps({"meta": meta, "scenes": data}))
     plot(data, RESULTS / "convergence.png")
 

@@ -78,6 +78,8 @@ def test_thicker_box_flares_more_and_keeps_less_of_the_thin_capacity(boxes):
     assert 0.0 < thin["wall_tilt_deg"] < thick["wall_tilt_deg"]
     assert (thick["volume_mm3"]["capacity_vs_thin_same_tilt"]
             < thin["volume_mm3"]["capacity_vs_thin_same_tilt"])
+    # the paper's "the volume of the box is also reduced", in absolute terms too
+    assert thick["volume_mm3"]["capacity"] < thin["volume_mm3"]["capacity"]
 
 
 def test_capacity_lies_between_the_thin_tray_and_it_minus_the_material(boxes):

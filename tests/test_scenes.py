@@ -54,6 +54,10 @@ def test_d4v_folds_further_and_keeps_mode_a(runs):
         assert abs(angles[1] + angles[3]) <= np.degrees(8.0 / 76.2)
     assert q["flat"]["fold_angles_deg"][0] > q["intermediate"]["fold_angles_deg"][0]
     assert q["flat"]["stack_height_mm"] > runs["d4v"].thickness
+    # 90° is below every crease's pivot angle 2·atan(W/H) (≥ 103°): the axis hinge
+    # folds the thick vertex on its rigid-origami path, to the closed form
+    closed = np.array(q["intermediate"]["closed_form_at_target_deg"])
+    assert np.abs(np.array(q["intermediate"]["fold_angles_deg"]) - closed).max() < 0.01
 
 
 def test_waterbomb_swaps_major_and_minor_and_follows_the_closed_form(runs):
@@ -71,8 +75,8 @@ def test_miura_follows_its_rigid_folding_path(runs):
     run = runs["miura"]
     q = run.quantities
     assert respects_assignment(run.pattern, run.result.fold_angles_deg)
-    for family in ("zigzag", "straight"):
-        assert q[family]["max_deviation_deg"] <= np.degrees(2.0 / 20.0)
+    for family in ("zigzag", "straight"):  # the axis hinge: compatible at any thickness
+        assert q[family]["max_deviation_deg"] < 0.01
     extent = q["extent_mm"]
     slack = (4 - 1) * 2.0
     assert abs(extent["corner_panels_x"] - extent["closed_form_x"]) <= slack

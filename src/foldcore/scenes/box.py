@@ -28,30 +28,34 @@ state is an isometry of the pattern with exactly these fold angles (tests).
 
 Thickening: every crease gets Eq. 7's width for a 180° fold, W = πH/2
 (1.57 mm at H = 1 mm, 6.28 mm at H = 4 mm, the paper's numbers), k = 4
-sub-strips (§6.1's 3–4), exact-arc targets; the crease pattern is the same
+sub-strips (§6.1's 3–4), the default axis hinge; the crease pattern is the same
 at both thicknesses, the thick 2D sheets are not (panels inset by W/2, larger
 residual holes at the vertices). Every crease is actuated to its thin-sheet
-angle. Solver: ``rigid`` by default — measured on this scene it converges in
-≈ 50 iterations (< 1 s) at both H, and it keeps the 180° mountain at its
-bound, whereas ``lbfgs``/``anderson``/``paper`` at H = 4 mm converge to a
-state whose fin has folded ≈ 4° through itself (measured diagonal +176°,
-i.e. −184°), and ``paper`` does not converge at H = 1 mm in 40 000 iterations.
+angle. Solver: ``rigid`` by default — it converges in 38–51 iterations
+(< 1.3 s) at both H and keeps the 180° mountain at its bound, whereas
+(measured with the arc hinge, the default then) ``lbfgs``/``anderson``/
+``paper`` at H = 4 mm converged to a state whose fin had folded ≈ 4° through
+itself (diagonal +176°, i.e. −184°), and ``paper`` did not converge at
+H = 1 mm in 40 000 iterations.
 
 What comes out (measured, not imposed): the thick tray cannot close its
-corners exactly — the 120° hinges bring the two fin layers together while
-the 180° fold needs them one thickness apart — so the least-squares
-compromise tilts the walls outward (≈ 9° at 1 mm, ≈ 16° at 4 mm) and the
-box is a slightly flared tray, more so when thicker. The tilt does not
-vanish as H → 0 with W = πH/2 (measured 7.7° at H = 0.1 mm): the mismatch
-and the hinges' compliance both scale with W, so only the panels' finite
-size (W against the 14 mm gusset leg) makes it grow with H. Real thick boxes
-avoid this with offsets (Chen et al.'s varied panel thickness), not SJT.
-Consequence for the volumes (measured): the 4 mm box keeps a smaller share
-of the thin tray's capacity at the same tilt (≈ 0.88 against ≈ 0.97), the
-paper's "the volume of the box is also reduced"; but its larger flare makes
-its absolute capacity slightly larger than the 1 mm box's (≈ 182 against
-≈ 180 cm³) — with this reconstruction the paper's absolute claim is not
-reproduced.
+corners exactly. With W = πH/2 the axis hinge pivots about its inner edges
+past θ* = 2·atan(π/2) = 115° (:mod:`foldcore.hinges`), so the 120° side
+creases and the 180° diagonal turn about lines off their crease lines, and
+each corner binds; the least-squares compromise tilts the walls outward
+(≈ 6.7° at 1 mm, ≈ 11.2° at 4 mm) and the box is a slightly flared tray,
+more so when thicker. The tilt does not vanish as H → 0 with W = πH/2
+(measured 6.1° at H = 0.1 mm): the pivot offsets and the hinges' compliance
+both scale with H, so only the panels' finite size makes it grow with H.
+Real thick boxes avoid this with offsets (Chen et al.'s varied panel
+thickness), not SJT. Consequence for the volumes (measured): the 4 mm box
+keeps a smaller share of the thin tray's capacity at the same tilt (≈ 0.81
+against ≈ 0.95), and a smaller absolute capacity (≈ 158 against ≈ 172 cm³):
+the paper's "the volume of the box is also reduced". With the paper's arc
+hinge (``hinge="arc"``, measured before the axis hinge was the default) the
+walls flared 8.7° and 16.2°, the shares were 0.97 and 0.88, and the 4 mm
+box held slightly more (182 against 180 cm³), so the absolute claim was not
+reproduced then.
 
 Quantities per thickness (``runs``): iterations, convergence, wall time;
 per crease family (bottom, side, diagonal) the target, the achieved mean
