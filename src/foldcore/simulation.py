@@ -113,19 +113,24 @@ class _GroupRun:
         self._prepared = False
 
     def project(self, x, targets, weights):
+        self.project_into(x, targets[self.slots], self.energy, self.state)
+        return float(self.energy @ weights)
+
+    def project_into(self, x, out, energy, state) -> None:
+        """Project every element at ``x`` into the given arrays (the rows of this
+        group's targets, its residuals (n,) mm², its state), with the kernel the
+        iterations use (``prepared_batch`` when the type has one)."""
         g, etype = self.group, self.etype
         if etype.prepared_batch is None:
-            etype.batch(x, g.indptr, g.indices, g.rest, self.params, targets[self.slots],
-                        self.energy, self.state)
-        else:
-            if not self._prepared:
-                if self._shapes is None:
-                    self._shapes = np.zeros_like(g.rest)
-                etype.prepare(g.indptr, g.rest, self.params, self._shapes)
-                self._prepared = True
-            etype.prepared_batch(x, g.indptr, g.indices, g.rest, self._shapes, self.params,
-                                 targets[self.slots], self.energy, self.state)
-        return float(self.energy @ weights)
+            etype.batch(x, g.indptr, g.indices, g.rest, self.params, out, energy, state)
+            return
+        if not self._prepared:
+            if self._shapes is None:
+                self._shapes = np.zeros_like(g.rest)
+            etype.prepare(g.indptr, g.rest, self.params, self._shapes)
+            self._prepared = True
+        etype.prepared_batch(x, g.indptr, g.indices, g.rest, self._shapes, self.params, out,
+                             energy, state)
 
 
 class Simulation:
@@ -610,11 +615,10 @@ class Simulation:
         if self._hinges is None:
             return np.zeros(0)
         run = self._hinges
-        g = run.group
-        residual = np.zeros(len(g))
-        run.etype.batch(self.x, g.indptr, g.indices, g.rest, run.params, np.zeros_like(g.rest),
-                        residual, np.zeros_like(run.state))
-        return np.sqrt(np.maximum(residual, 0.0) / np.diff(g.indptr))
+        residual = np.zeros(len(run.group))
+        run.project_into(self.x, np.zeros_like(run.group.rest), residual,
+                         np.zeros_like(run.state))
+        return np.sqrt(np.maximum(residual, 0.0) / np.diff(run.group.indptr))
 
     # --------------------------------------------------------------- private
     def _targets_changed(self) -> None:
