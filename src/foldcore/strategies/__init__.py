@@ -11,10 +11,10 @@ one strategy, which only moves the state. Built in:
   (:mod:`.lbfgs`).
 * ``rigid`` — rigid panels as rigid bodies, Levenberg–Marquardt with geodesic
   acceleration (:mod:`.rigid`, engine in :mod:`foldcore.rigid_body`).
-* ``hybrid`` — a composite: each run starts with ``rigid`` steps and
-  continues with ``lbfgs`` from where they stop, on the paper's energy; a
-  mesh ``rigid`` cannot take (elastic cells, other element types) runs
-  ``lbfgs`` (:mod:`.hybrid`).
+* ``hybrid`` — a composite: each run starts with ``rigid`` steps, ends
+  there once they meet the tolerance, else continues with ``lbfgs`` from
+  where they stop; a mesh ``rigid`` cannot take (elastic cells, other
+  element types) runs ``lbfgs`` (:mod:`.hybrid`).
 
 The protocol (:class:`Strategy`): ``step()`` advances ``sim.x`` by one
 iteration and returns (energy before, largest move in mm); ``settled(moved,
@@ -36,11 +36,14 @@ _REGISTRY: dict[str, type] = {}
 
 #: The default strategy (bench/convergence, bench/accuracy, README tables):
 #: ``hybrid``. Its rigid phase brings long panels and closed loops to the
-#: rigid-body model's state in a few iterations whatever the panel length
-#: (single hinge to 0.01° in 3–8 iterations at Lp/H = 5–320, where ``lbfgs``
-#: alone needs 31–1 980 and ``paper`` 10 280 and never), and its L-BFGS phase
-#: then settles on the paper's own energy, with every element type (meshes
-#: the rigid phase cannot take run L-BFGS alone).
+#: rigid-body model's equilibrium in a few iterations whatever the panel
+#: length (single hinge to 0.01° in 3–8 iterations at Lp/H = 5–320, where
+#: ``lbfgs`` alone needs 29–1 960 and ``paper`` 10 280 and never; thin
+#: vertices, the waterbomb and Miura sheets up to 20 × 20 from flat, where
+#: the local/global strategies mostly do not fold within 20 000 iterations)
+#: and ends the run there;
+#: L-BFGS takes over where that phase cannot settle, and runs alone on
+#: meshes it cannot take (elastic cells, other element types).
 DEFAULT_SOLVER = "hybrid"
 
 
