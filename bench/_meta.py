@@ -52,3 +52,9 @@ def machine_meta() -> dict:
     return {"machine": cpu_model(), "caches": cpu_caches(), "cpus": os.cpu_count(),
             "numba_threads": numba.get_num_threads(), "python": platform.python_version(),
             "numba": numba.__version__, "backend": "cholmod" if cholmod_available() else "scipy"}
+
+
+def markdown_table(header: list, rows: list) -> str:
+    """A Markdown table (the README's) from a header row and rows of cell strings."""
+    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    return "\n".join(lines + ["| " + " | ".join(row) + " |" for row in rows])

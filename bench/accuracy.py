@@ -38,7 +38,7 @@ import numpy as np
 from foldcore import kinematics, patterns, thicken
 from foldcore.simulation import Simulation
 
-from _meta import machine_meta
+from _meta import machine_meta, markdown_table
 from scaling import others_busy
 
 RESULTS = Path(__file__).parent / "results"
@@ -215,18 +215,18 @@ def table(path: Path = RESULTS / "accuracy.json") -> str:
     cases += [("thickness", f"Pehrson {m}, H/R = {r:g}", {"h_over_r": r, "mode": m})
               for r in THICKNESS_RATIOS for m in "AB"]
     cases += [("size", f"Miura {n} × {n}", {"n": n}) for n in MIURA_SIZES]
-    head = "| case | " + " | ".join(f"{m} / {s}" + (", angle" if a == "angle" else "")
-                                     for m, s, a in columns) + " |"
-    lines = [head, "|" + "---|" * (len(columns) + 1)]
+    header = ["case"] + [f"{m} / {s}" + (", angle" if a == "angle" else "")
+                         for m, s, a in columns]
+    body = []
     for sweep, label, where in cases:
-        cells = []
+        cells = [label]
         for model, strategy, actuation in columns:
             rows = [r for r in data[sweep] if r["model"] == model and r["strategy"] == strategy
                     and r["actuation"] == actuation and all(r[k] == v for k, v in where.items())]
             cells.append(f"{rows[0]['error_deg']:.2g}° / {rows[0]['seconds']:.2g} s" if rows
                          else "—")
-        lines.append(f"| {label} | " + " | ".join(cells) + " |")
-    return "\n".join(lines)
+        body.append(cells)
+    return markdown_table(header, body)
 
 
 if __name__ == "__main__":

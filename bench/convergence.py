@@ -47,7 +47,7 @@ import numpy as np
 from foldcore import kinematics, patterns, thicken
 from foldcore.simulation import Simulation
 
-from _meta import machine_meta
+from _meta import machine_meta, markdown_table
 from scaling import others_busy
 
 RESULTS = Path(__file__).parent / "results"
@@ -237,15 +237,15 @@ def table(path: Path = RESULTS / "convergence.json") -> str:
     """Markdown: per scene and strategy, iterations (strategy seconds) to 0.01°, or
     'never' with the final error."""
     scenes = json.loads(path.read_text())["scenes"]
-    lines = ["| scene | " + " | ".join(SOLVERS) + " |", "|" + "---|" * (len(SOLVERS) + 1)]
+    body = []
     for name, rows in scenes.items():
-        cells = []
+        cells = [name]
         for solver in SOLVERS:
             hit = rows[solver]["to_threshold"]["0.01"]
             cells.append(f"{hit['iterations']} ({hit['seconds']:.2g} s)" if hit else
                          f"never ({rows[solver]['final_error_deg']:.3g}°)")
-        lines.append(f"| {name} | " + " | ".join(cells) + " |")
-    return "\n".join(lines)
+        body.append(cells)
+    return markdown_table(["scene", *SOLVERS], body)
 
 
 if __name__ == "__main__":

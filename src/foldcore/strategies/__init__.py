@@ -41,9 +41,9 @@ _REGISTRY: dict[str, type] = {}
 #: ``lbfgs`` alone needs 29–1 960 and ``paper`` 10 280 and never; thin
 #: vertices, the waterbomb and Miura sheets up to 20 × 20 from flat, where
 #: the local/global strategies mostly do not fold within 20 000 iterations)
-#: and ends the run there;
-#: L-BFGS takes over where that phase cannot settle, and runs alone on
-#: meshes it cannot take (elastic cells, other element types).
+#: and ends the run there; L-BFGS takes over where that phase cannot
+#: settle, and runs alone on meshes it cannot take (elastic cells, other
+#: element types).
 DEFAULT_SOLVER = "hybrid"
 
 
