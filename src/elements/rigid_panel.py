@@ -10,7 +10,6 @@ vertices in the same order)::
 The projection rotates the rest shape onto the current one (Kabsch, det = +1).
 """
 from numba import njit, prange
-import numpy as np
 
 from ._registry import ElementType
 from ._rotation import fit_rotated
