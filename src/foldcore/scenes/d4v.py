@@ -69,5 +69,7 @@ def run(quick: bool = False, solver: str | None = None) -> SceneRun:
 
 
 def headline(quantities: dict) -> str:
-    """One line for the demo: crease 1 at the flat target."""
-    return f"crease 1 at the flat target: {quantities['flat']['fold_angles_deg'][0]}°"
+    """One line for the demo: crease 1 at 90° and driven toward flat (180°)."""
+    flat, mid = quantities["flat"], quantities["intermediate"]
+    return (f"crease 1 driven to 90°: {mid['fold_angles_deg'][0]}°, to 180°: "
+            f"{flat['fold_angles_deg'][0]}°")
