@@ -3,7 +3,9 @@
 #   make test    run the test suite
 #   make bench   run the benchmarks (results in bench/results/)
 # Both demo and test do all set-up first: system library for CHOLMOD (when
-# root), a virtual environment in .venv, the package with its extras.
+# root), a virtual environment in .venv, the package with its extras, and the
+# default path's numba kernels compiled once (foldcore.warmup), so the first
+# simulation starts warm.
 
 PYTHON ?= python3
 VENV := .venv
@@ -25,6 +27,7 @@ $(STAMP): pyproject.toml
 	    echo "foldcore: SuiteSparse headers missing: installing without CHOLMOD (SciPy fallback)"; \
 	    $(PY) -m pip install --quiet -e ".[render,export,dev]"; \
 	fi
+	$(PY) -m foldcore.warmup
 	touch $(STAMP)
 
 demo: setup

@@ -6,6 +6,7 @@ imported everything.
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 import sys
 
@@ -33,9 +34,9 @@ print(json.dumps(misses))
 """
 
 
-def _probe(code: str) -> dict:
+def _probe(code: str, env=None) -> dict:
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                          timeout=600, check=True)
+                          timeout=600, check=True, env=env)
     return json.loads(proc.stdout.strip().splitlines()[-1])
 
 
@@ -49,6 +50,32 @@ def test_second_process_loads_kernels_from_the_cache():
     _probe(RUN_PROBE)                  # compiles (cold) or loads (warm)
     misses = _probe(RUN_PROBE)         # a new process: nothing may compile
     assert all(n == 0 for n in misses.values()), misses
+
+
+CLI_PROBE = """
+import json
+from foldcore import patterns
+from foldcore.cli import main
+from foldcore.io import write_fold
+from foldcore.warmup import _cache_counts
+p = patterns.single_hinge(panel_length=5.0, depth=2.0, angle=90.0, width=2.0)
+write_fold({src!r}, p, thickness=1.0)
+assert main(["simulate", {src!r}, "-o", {out!r}]) == 0
+print(json.dumps(_cache_counts()))
+"""
+
+
+def test_warmup_compiles_what_a_first_simulate_needs(tmp_path):
+    """After ``python -m foldcore.warmup`` (the set-up's last step), a default
+    ``foldcore simulate`` of a hinge in a new process compiles no kernel. Both
+    run on an empty numba cache of their own (NUMBA_CACHE_DIR), so the project's
+    warm cache cannot hide a kernel the warm-up misses (cold: ~20 s)."""
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "numba")}
+    subprocess.run([sys.executable, "-m", "foldcore.warmup"], capture_output=True,
+                   timeout=600, check=True, env=env)
+    code = CLI_PROBE.format(src=str(tmp_path / "h.fold"), out=str(tmp_path / "o.fold"))
+    counts = _probe(code, env)
+    assert counts["compiled"] == 0 and counts["loaded"] > 0, counts
 
 
 def test_public_names_survive_submodule_imports():
