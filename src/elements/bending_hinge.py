@@ -56,7 +56,8 @@ def estimate_angle(x, ids):
     """Bend angle (rad, valley > 0) of a strip from its current shape (Eq. 9).
 
     H_p is the perpendicular height √(s² − d²), s the mean end-face length and
-    d = (W_b − W_t)/2, so Eq. 8 trapezoids and exact arcs both return their θ.
+    d = (W_b − W_t)/2, so Eq. 8 trapezoids and every arc (axis or constant
+    length) return their θ.
     """
     w_top, w_bot = strip_widths(x, ids)
     s = 0.25 * (distance(x, ids[0], ids[4]) + distance(x, ids[1], ids[5])
