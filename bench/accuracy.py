@@ -65,15 +65,9 @@ def vertex(width_over_h: float, h_over_r: float, mode: str = "A"):
 def miura(n: int):
     """Thin Miura n × n, one zig-zag crease driven: (pattern, H, closed form, creases)."""
     thickness = 1e-3 * A
-    expected = patterns.miura_fold_angles(n, n, 60.0, 30.0)
-    kinds = patterns.miura_edge_kinds(n, n)
-    zigzag = np.flatnonzero(kinds == "zigzag")
-    angles = [None] * len(expected)
-    angles[int(zigzag[len(zigzag) // 2])] = float(expected[int(zigzag[len(zigzag) // 2])])
-    pattern = patterns.miura(n, n, a=A, b=A, gamma=60.0, width=3 * thickness).replace(
-        fold_angles=angles)
-    creases = np.flatnonzero(kinds != "boundary")
-    return pattern, thickness, expected[creases], creases
+    pattern = patterns.miura_one_crease(n, n, a=A, b=A, width=3 * thickness)
+    creases = np.flatnonzero(patterns.miura_edge_kinds(n, n) != "boundary")
+    return pattern, thickness, patterns.miura_fold_angles(n, n, 60.0, 30.0)[creases], creases
 
 
 def fold(scene, model: str, strategy: str, actuation: str = "equal", budget: int = BUDGET,

@@ -49,17 +49,11 @@ def vertex(sectors, mode):
 
 
 def miura(n, h_over_a, w_over_h):
-    a = 20.0
-    h = h_over_a * a
-    expected = patterns.miura_fold_angles(n, n, 60.0, 30.0)
-    kinds = patterns.miura_edge_kinds(n, n)
-    zigzag = np.flatnonzero(kinds == "zigzag")
-    angles = [None] * len(expected)
-    angles[int(zigzag[len(zigzag) // 2])] = float(expected[int(zigzag[len(zigzag) // 2])])
-    pattern = patterns.miura(n, n, a=a, b=a, gamma=60.0, width=w_over_h * h).replace(
-        fold_angles=angles)
-    creases = np.flatnonzero(kinds != "boundary")
-    return f"Miura {n}x{n} H/a={h_over_a:g}", pattern, h, expected[creases], creases
+    h = h_over_a * 20.0
+    pattern = patterns.miura_one_crease(n, n, width=w_over_h * h)
+    creases = np.flatnonzero(patterns.miura_edge_kinds(n, n) != "boundary")
+    return (f"Miura {n}x{n} H/a={h_over_a:g}", pattern, h,
+            patterns.miura_fold_angles(n, n, 60.0, 30.0)[creases], creases)
 
 
 def one(case, model, floor) -> dict:

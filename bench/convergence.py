@@ -82,15 +82,9 @@ def pehrson_scene(rho1: float):
 def miura_scene(n: int, thickness: float):
     """Miura n×n (a = b = 20, γ = 60°), W = 2H, k = 2; one interior zig-zag crease
     actuated to 60° (facet tilt θ = 30°), all others passive."""
-    pattern = patterns.miura(n, n, a=20.0, b=20.0, gamma=60.0, width=2.0 * thickness)
-    kinds = patterns.miura_edge_kinds(n, n)
+    pattern = patterns.miura_one_crease(n, n, width=2.0 * thickness)
     expected = patterns.miura_fold_angles(n, n, 60.0, 30.0)
-    creases = np.flatnonzero(kinds != "boundary")
-    zz = np.flatnonzero(kinds == "zigzag")
-    actuated = int(zz[len(zz) // 2])
-    angles = [None] * pattern.n_edges
-    angles[actuated] = float(expected[actuated])
-    pattern = pattern.replace(fold_angles=angles)
+    creases = np.flatnonzero(patterns.miura_edge_kinds(n, n) != "boundary")
     return pattern, thicken(pattern, thickness, subdivisions=2), expected[creases], creases
 
 

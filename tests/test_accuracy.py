@@ -94,27 +94,14 @@ def test_degree5_box_corner_closes(tmp_path):
     assert np.abs(achieved - closed).max() < BOUND
 
 
-def miura_one_crease(n: int, a: float):
-    """Miura n × n (a = b, γ = 60°), one interior zig-zag crease driven to its angle
-    at facet tilt 30°, the rest passive; (pattern, closed-form angles (E,))."""
-    expected = patterns.miura_fold_angles(n, n, 60.0, 30.0)
-    kinds = patterns.miura_edge_kinds(n, n)
-    zigzag = np.flatnonzero(kinds == "zigzag")
-    driven = int(zigzag[len(zigzag) // 2])
-    angles = [None] * len(expected)
-    angles[driven] = float(expected[driven])
-    return patterns.miura(n, n, a=a, b=a, gamma=60.0).replace(fold_angles=angles), expected
-
-
 @pytest.mark.parametrize("n, width_over_h, thickness_over_a", [(5, 3.0, 1e-3),
                                                                 (10, 1.0, 1e-3),
                                                                 (10, 1.0, 0.1)])
 def test_miura_driven_by_one_crease_follows_rigid_folding(tmp_path, n, width_over_h,
                                                           thickness_over_a):
-    a = 20.0
-    thickness = thickness_over_a * a
-    pattern, expected = miura_one_crease(n, a)
-    pattern = pattern.replace(widths=[width_over_h * thickness] * pattern.n_edges)
+    thickness = thickness_over_a * 20.0
+    pattern = patterns.miura_one_crease(n, n, width=width_over_h * thickness)
+    expected = patterns.miura_fold_angles(n, n, 60.0, 30.0)
     achieved = cli_fold(tmp_path, pattern, thickness)
     creases = patterns.miura_edge_kinds(n, n) != "boundary"
     assert np.abs(achieved[creases] - expected[creases]).max() < BOUND

@@ -205,6 +205,14 @@ def test_grid():
     assert np.count_nonzero(cp.assignments == "U") == 7
 
 
+def test_miura_one_crease_drives_only_the_middle_zigzag_edge():
+    pattern = p.miura_one_crease(4, 3, tilt=20.0)
+    driven = np.flatnonzero(np.isfinite(pattern.fold_angles))
+    zigzag = np.flatnonzero(p.miura_edge_kinds(4, 3) == "zigzag")
+    assert driven.tolist() == [int(zigzag[len(zigzag) // 2])]
+    assert pattern.fold_angles[driven[0]] == p.miura_fold_angles(4, 3, 60.0, 20.0)[driven[0]]
+
+
 def test_single_vertex_of_degree_five_and_its_refusals():
     pattern = p.single_vertex((120.0, 90.0, 30.0, 30.0, 90.0), list("VVVMV"),
                               [60.0, 60.0, None, None, None], radius=10.0)

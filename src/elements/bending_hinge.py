@@ -246,6 +246,14 @@ def project(x, ids, rest, params, out, state):
     return fit_rotated(x, ids, out, out)
 
 
+@njit(cache=True)
+def project_in_series(x, ids, rest, params, angles, e, out):
+    """Rotated target of strip ``e`` bent by ``angles[e, 0]`` for its crease's bend
+    (:func:`series_bend` over ``angles``), written to ``out``; its residual (mm²)."""
+    bend(rest, params[e], angles[e, 0], series_bend(angles, params, e), out)
+    return fit_rotated(x, ids, out, out)
+
+
 @njit(parallel=True, cache=True)
 def batch(x, indptr, indices, rest, params, out, energy, state):
     """Project every sub-strip; ``energy[e]`` residual (mm²), ``state[e, 0]`` angle (rad).
@@ -259,8 +267,7 @@ def batch(x, indptr, indices, rest, params, out, energy, state):
         state[e, 0] = strip_angle(x, indices[indptr[e]:indptr[e + 1]], params[e])
     for e in prange(len(indptr) - 1):
         s, t = indptr[e], indptr[e + 1]
-        bend(rest[s:t], params[e], state[e, 0], series_bend(state, params, e), out[s:t])
-        energy[e] = fit_rotated(x, indices[s:t], out[s:t], out[s:t])
+        energy[e] = project_in_series(x, indices[s:t], rest[s:t], params, state, e, out[s:t])
 
 
 @njit(parallel=True, cache=True)
@@ -290,8 +297,8 @@ def prepared_batch(x, indptr, indices, rest, shapes, params, out, energy, state)
     for e in prange(len(indptr) - 1):
         s, t = indptr[e], indptr[e + 1]
         if math.isnan(params[e, TARGET]):
-            bend(rest[s:t], params[e], state[e, 0], series_bend(state, params, e), out[s:t])
-            energy[e] = fit_rotated(x, indices[s:t], out[s:t], out[s:t])
+            energy[e] = project_in_series(x, indices[s:t], rest[s:t], params, state, e,
+                                          out[s:t])
         else:
             energy[e] = fit_rotated(x, indices[s:t], shapes[s:t], out[s:t])
 

@@ -50,6 +50,11 @@ def fold_angles(pattern, mesh, positions: np.ndarray) -> np.ndarray:
     return out
 
 
+def wrapped_deg(angles) -> np.ndarray:
+    """Angles or angle differences (degrees) wrapped into [−180, 180)."""
+    return (np.asarray(angles, dtype=float) + 180.0) % 360.0 - 180.0
+
+
 def dihedral_deg(n_left: np.ndarray, n_right: np.ndarray, d: np.ndarray) -> np.ndarray:
     """(n,) fold angles, degrees, valley positive: ρ = atan2((n_R × n_L)·d̂, n_L·n_R)
     for unit face normals n_L, n_R (n, 3) left and right of creases along d (n, 3)."""

@@ -45,13 +45,10 @@ def _iteration_cost(result) -> dict:
             if t["bare_solve"] > 0 else None}
 
 
-def wrapped_deg(angles) -> np.ndarray:
-    """Angle differences (degrees) wrapped into [−180, 180)."""
-    return (np.asarray(angles, dtype=float) + 180.0) % 360.0 - 180.0
-
-
 def actuation_entries(result, pattern) -> dict:
     """Per actuated crease: effective target, achieved angle and miss (degrees)."""
+    from .measure import wrapped_deg
+
     targets = result.target_angles_deg if result.target_angles_deg is not None \
         else np.array(pattern.fold_angles, dtype=float)
     driven = np.flatnonzero(np.isfinite(targets))

@@ -16,8 +16,9 @@ from . import kinematics
 from .errors import PatternError
 from .pattern import CreasePattern
 
-__all__ = ["degree4_vertex", "single_vertex", "waterbomb", "miura", "miura_edge_kinds", "miura_fold_angles",
-           "single_hinge", "grid", "degree4_assignments"]
+__all__ = ["degree4_vertex", "single_vertex", "waterbomb", "miura", "miura_edge_kinds",
+           "miura_fold_angles", "miura_one_crease", "single_hinge", "grid",
+           "degree4_assignments"]
 
 PEHRSON_SECTORS = (135.0, 90.0, 45.0, 90.0)
 PEHRSON_WIDTHS = (16.0, 4.0, 8.0, 4.0)
@@ -316,6 +317,24 @@ def miura_fold_angles(n: int, m: int, gamma: float, tilt: float) -> np.ndarray:
     zigzag, straight = kinematics.miura_angles_deg(gamma, tilt)
     sign = np.where(np.array(_miura_assignments(n, m)) == "M", -1.0, 1.0)
     return sign * np.select([kinds == "zigzag", kinds == "straight"], [zigzag, straight], np.nan)
+
+
+def miura_one_crease(n: int, m: int, a: float = 20.0, b: float = 20.0, gamma: float = 60.0,
+                     tilt: float = 30.0, width: float = np.nan) -> CreasePattern:
+    """:func:`miura` driven by a single crease: the middle interior zig-zag edge
+    (middle in the pattern's edge order) targets its rigid-fold angle at facet
+    tilt θ (degrees, :func:`miura_fold_angles`), every other crease is passive.
+
+    The 1-DOF sheet folded by one actuator: a rigid-foldable model must bring
+    every crease to ``miura_fold_angles(n, m, gamma, tilt)``; the accuracy
+    tests and benchmarks compare against exactly that.
+    """
+    expected = miura_fold_angles(n, m, gamma, tilt)
+    zigzag = np.flatnonzero(miura_edge_kinds(n, m) == "zigzag")
+    driven = int(zigzag[len(zigzag) // 2])
+    angles = [None] * len(expected)
+    angles[driven] = float(expected[driven])
+    return miura(n, m, a=a, b=b, gamma=gamma, width=width).replace(fold_angles=angles)
 
 
 def _miura_assignments(n: int, m: int) -> list[str]:

@@ -112,7 +112,7 @@ class RigidBodySolver:
                                   f"(mesh has {sorted(mesh.groups)}); use solver='paper'")
         self.sim = sim
         self.backend = sim.system.factor.backend
-        self._weights_version = None  # K's version the strip weights were read at
+        self._weights_read = None  # the Simulation's strip-weight array sqrt_w was taken from
         self._init_panels(mesh.groups["rigid_panel"], mesh.n_vertices, sim.x)
         self._init_strips(sim._hinges)
         self._init_mv_sides(mesh, sim.pattern)
@@ -185,12 +185,13 @@ class RigidBodySolver:
 
     def _sync_weights(self) -> None:
         """Strip weights (√w) and the position Jacobian from the Simulation's current
-        weights (actuation and stops change them; K's version says when)."""
-        system = self.sim.system
-        if self._weights_version == system.version:
+        weights (actuation and stops change them: ``System.set_weights`` stores a
+        new array, so a different array is the sign)."""
+        weights = self.sim.system.weights[self.sim._hinge_index]
+        if weights is self._weights_read:
             return
-        self._weights_version = system.version
-        self.sqrt_w = np.sqrt(system.weights[self.sim._hinge_index])
+        self._weights_read = weights
+        self.sqrt_w = np.sqrt(weights)
         self.jx = self._strip_position_jacobian()
 
     def _init_carriers(self, mesh, pattern) -> None:

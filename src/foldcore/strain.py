@@ -36,7 +36,7 @@ TOP, BOTTOM = 0, 1
 def strip_strains(params: np.ndarray, phi: np.ndarray) -> np.ndarray:
     """(S, 2) surface strains (top, bottom) of sub-strips bent by ``phi`` (S,) rad.
 
-    ``params`` (S, 8) are the hinge parameters (``HINGE_PARAMS``): width w,
+    ``params`` (S, 9) are the hinge parameters (``HINGE_PARAMS``): width w,
     height H, the hinge model and its sub-strip count decide the formula
     (module docstring).
     """

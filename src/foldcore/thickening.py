@@ -31,7 +31,7 @@ def minimum_hinge_width(thickness: float, max_angle_deg, bend_radius: float = 0.
     return (bend_radius + 0.5 * thickness) * np.radians(max_angle_deg)
 
 
-def auto_subdivisions(width, thickness: float, max_angle_deg, hinge="axis") -> np.ndarray:
+def auto_subdivisions(width, thickness: float, max_angle_deg, hinge=DEFAULT_HINGE) -> np.ndarray:
     """Sub-strips per hinge chosen from its largest fold angle.
 
     Rule: k = max(2, ceil(θmax / 45°)) (smoothness, paper §6.1). With Eq. 8

@@ -25,6 +25,7 @@ import itertools
 
 import numpy as np
 
+from ..measure import wrapped_deg
 from ..patterns import single_hinge
 from ..simulation import Simulation
 from ..thickening import thicken
@@ -55,7 +56,7 @@ def run(quick: bool = False, solver: str | None = None) -> SceneRun:
         rows.append({
             "hinge": model, "width_mm": width,
             "subdivisions": k, "fold_angle_deg": round(achieved, 5),
-            "angle_error_deg": round(abs((achieved - ANGLE + 180.0) % 360.0 - 180.0), 5),
+            "angle_error_deg": round(abs(float(wrapped_deg(achieved - ANGLE))), 5),
             "inner_radius_mm": _rounded(inner_radius(mesh, result.positions)),
             "eq7_inner_radius_mm": round(float(width / np.radians(ANGLE)) - 0.5 * THICKNESS,
                                          5),

@@ -26,9 +26,11 @@ class Accelerated(Strategy):
     from, a rejection count and the version of K their history belongs to."""
 
     abstract = True
+    MEMORY = 0  # history kept (each strategy's own default)
 
-    def __init__(self, sim):
+    def __init__(self, sim, memory: int | None = None):
         super().__init__(sim)
+        self.memory = int(self.MEMORY if memory is None else memory)
         self.x = sim.x
         self.rejected = 0  # accelerated points refused (Anderson) / failed line searches (L-BFGS)
         self._version = sim.system.version

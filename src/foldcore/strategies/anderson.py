@@ -27,10 +27,7 @@ class Anderson(Accelerated):
     """
 
     name = "anderson"
-
-    def __init__(self, sim, memory: int = ANDERSON_MEMORY):
-        self.memory = int(memory)
-        super().__init__(sim)
+    MEMORY = ANDERSON_MEMORY
 
     def _forget(self) -> None:
         self._dg = deque(maxlen=self.memory)

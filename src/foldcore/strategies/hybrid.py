@@ -69,11 +69,9 @@ class Hybrid(Strategy):
         return self.rigid.step()
 
     def settled(self, moved: float, limit: float) -> bool:
-        if self.rigid is None:
-            return moved <= limit
-        done = moved <= limit
-        floor = HYBRID_RIGID_TOL * self.sim.length_scale
-        if done or moved <= floor or self._rigid_steps >= HYBRID_RIGID_MAX:
+        done = super().settled(moved, limit)
+        if self.rigid is not None and (done or moved <= HYBRID_RIGID_TOL * self.sim.length_scale
+                                       or self._rigid_steps >= HYBRID_RIGID_MAX):
             self._leave_rigid_phase()
         return done
 

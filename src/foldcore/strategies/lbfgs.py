@@ -26,10 +26,7 @@ class Lbfgs(Accelerated):
     """
 
     name = "lbfgs"
-
-    def __init__(self, sim, memory: int = LBFGS_MEMORY):
-        self.memory = int(memory)
-        super().__init__(sim)
+    MEMORY = LBFGS_MEMORY
 
     def _forget(self) -> None:
         self._pairs = deque(maxlen=self.memory)
