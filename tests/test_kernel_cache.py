@@ -69,3 +69,21 @@ def test_a_plugin_tracks_the_helpers_it_calls_through_extra_dirs(tmp_path):
     assert _cache.drop_stale_kernels(plugin, "0.68.1", extra_dirs=[helpers]) == 0
     (helpers / "rotation.py").write_text("R = 2\n")
     assert _cache.drop_stale_kernels(plugin, "0.68.1", extra_dirs=[helpers]) == 1
+
+
+def test_a_guarded_module_ignores_its_siblings_and_keeps_their_caches(tmp_path):
+    package = tmp_path / "pkg"
+    package.mkdir()
+    (package / "solver.py").write_text("def f(): pass\n")
+    (package / "other.py").write_text("x = 1\n")
+    (package / "helper.py").write_text("H = 1\n")
+    cache = package / "__pycache__"
+    cache.mkdir()
+    _cache.drop_stale_kernels(package, "0.68.1", module="solver")
+    (cache / "solver.f-1.py311.nbi").write_bytes(b"")
+    (cache / "other.g-1.py311.nbi").write_bytes(b"")
+    (package / "other.py").write_text("x = 2\n")  # a sibling edited: nothing to drop
+    assert _cache.drop_stale_kernels(package, "0.68.1", module="solver") == 0
+    (package / "solver.py").write_text("def f(): return 1\n")
+    assert _cache.drop_stale_kernels(package, "0.68.1", module="solver") == 1
+    assert sorted(p.name for p in cache.glob("*.nbi")) == ["other.g-1.py311.nbi"]

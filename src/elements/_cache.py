@@ -35,12 +35,14 @@ STAMP_NAME = "foldcore-kernel-sources.sha256"
 NUMBA_SUFFIXES = (".nbi", ".nbc")
 
 
-def sources_digest(package_dir: Path, numba_version: str, extra_dirs=()) -> str:
+def sources_digest(package_dir: Path, numba_version: str, extra_dirs=(), module=None) -> str:
     """SHA-256 (hex) over the numba version and each ``*.py`` file's name and bytes, in
-    ``package_dir`` and then each of ``extra_dirs`` (folders of helpers it calls)."""
+    ``package_dir`` (only ``module``.py when given) and then each of ``extra_dirs``
+    (folders of helpers it calls)."""
     digest = hashlib.sha256(numba_version.encode())
-    for folder in (package_dir, *extra_dirs):
-        for path in sorted(Path(folder).glob("*.py")):
+    for folder, pattern in ((package_dir, f"{module}.py" if module else "*.py"),
+                            *((d, "*.py") for d in extra_dirs)):
+        for path in sorted(Path(folder).glob(pattern)):
             digest.update(path.name.encode() + b"\0" + path.read_bytes() + b"\0")
     return digest.hexdigest()
 
@@ -61,7 +63,8 @@ def cache_dirs(package_dir: Path) -> list[Path]:
     return dirs
 
 
-def drop_stale_kernels(package_dir: Path, numba_version: str, extra_dirs=()) -> int:
+def drop_stale_kernels(package_dir: Path, numba_version: str, extra_dirs=(),
+                       module=None) -> int:
     """Remove numba cache files built from other sources than the current ones.
 
     Parameters
@@ -74,6 +77,11 @@ def drop_stale_kernels(package_dir: Path, numba_version: str, extra_dirs=()) -> 
         Folders of helpers the kernels call (a plugin passes the ``elements``
         folder, so a foldcore upgrade that changes ``_rotation`` drops its
         kernels too).
+    module : str, optional
+        Guard one module of ``package_dir`` only (its source, its cache files,
+        its own stamp), e.g. a module of foldcore whose kernels call
+        ``elements._rotation``, so that editing the package's other files does
+        not recompile them.
 
     Returns
     -------
@@ -82,10 +90,10 @@ def drop_stale_kernels(package_dir: Path, numba_version: str, extra_dirs=()) -> 
         no cache yet). Best effort: unreadable or read-only locations are left
         alone (numba then recompiles into its user-wide cache, keyed per file).
     """
-    stamp = sources_digest(package_dir, numba_version, extra_dirs)
+    stamp = sources_digest(package_dir, numba_version, extra_dirs, module)
     removed = 0
     for folder in cache_dirs(package_dir):
-        marker = folder / STAMP_NAME
+        marker = folder / (f"{module}-{STAMP_NAME}" if module else STAMP_NAME)
         try:
             if marker.read_text() == stamp:
                 continue
@@ -94,7 +102,8 @@ def drop_stale_kernels(package_dir: Path, numba_version: str, extra_dirs=()) -> 
         try:
             folder.mkdir(parents=True, exist_ok=True)
             for path in folder.iterdir():
-                if path.suffix in NUMBA_SUFFIXES:
+                if path.suffix in NUMBA_SUFFIXES and (module is None
+                                                      or path.name.startswith(f"{module}.")):
                     path.unlink(missing_ok=True)
                     removed += 1
             partial = marker.with_suffix(f".{os.getpid()}.tmp")

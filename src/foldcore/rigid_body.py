@@ -21,6 +21,11 @@ equations (Levenberg–Marquardt, Marquardt scaling), keeps the step only if E
 decreases, then refits every strip's rotation exactly (Procrustes: the
 paper's local step, which can only lower E).
 
+The normal equations JᵀJ, Jᵀr are assembled strip by strip in numba
+(:mod:`foldcore.rigid_normal`) on a pattern fixed per column layout, so the
+factorisation reuses its symbolic analysis; J itself is never formed (the
+sparse :meth:`RigidBodySolver._jacobian` remains as the tests' reference).
+
 Units: mm, rad internally.
 """
 from __future__ import annotations
@@ -33,19 +38,25 @@ import scipy.sparse as sp
 
 from elements.bending_hinge import FLOOR, MAX_ANGLE, SIGN, TARGET, estimate_angles, shapes
 from .errors import SimulationError
+from . import rigid_normal
 from .linsolve import Factor
 from .measure import best_rotations
 
 SEED = 1e-2          # rad: pre-bend of a passive M/V strip that starts flat
 LAMBDA_START = 1e-4  # initial Levenberg–Marquardt damping (relative to diag of JᵀJ)
 LAMBDA_MIN, LAMBDA_MAX = 1e-12, 1e12
+LAMBDA_DOWN, LAMBDA_UP = 3.0, 5.0  # damping divided after an accepted step, multiplied after a rejected one
 BOUND_TOL = 1e-12    # rad: a bounded angle this close to its bound is on it
 GEODESIC_H = 0.1     # finite-difference step of the geodesic acceleration (fraction of the step)
 GEODESIC_MAX = 1.5   # acceleration kept only if |a| ≤ this × |v|
 MV_STIFFNESS = 1e3   # weight (× reference weight × W²) of the panels' M/V side rows; 0: off
-MV_SLACK = 1e-9      # rad a panel dihedral may cross to the wrong side before its row acts
+MV_SLACK = 1e-6      # rad a panel dihedral may cross to the wrong side before its row acts
 #                      (flat panels cross zero by rounding; rows there would make paths
-#                      depend on the last bit, e.g. on the length unit)
+#                      depend on the last bit, e.g. on the length unit). Measured: at 1e-9
+#                      the rows fired on nearly flat creases early in a fold from flat and
+#                      LM crept (thin Miura 10 × 10, rigid: 120 iterations, 71 at 1e-7…3e-6;
+#                      20 × 20 hybrid 214 → 99); at 1e-4 thin mode-B vertices fold mode A
+#                      (tests/test_accuracy.py)
 
 
 class State(NamedTuple):
@@ -207,9 +218,12 @@ class RigidBodySolver:
         free_index = np.full(mesh.n_vertices, -1, dtype=np.int64)
         free_index[self.free] = np.arange(len(self.free))
         vert, panel, weight = [], [], []
+        self.strip_side = np.zeros((len(self.ids), 2), dtype=np.int64)  # crease's panels
+        side_weight = np.zeros((len(self.free), 2))  # each free vertex's blend weights
         for e, strips in mesh.strips_of_crease.items():
             ids = np.unique(self.ids[strips])
             side = [mesh.panel_of_face[f] for f in pattern.edge_faces[e]]
+            self.strip_side[strips] = side
             inner = ids[free_index[ids] >= 0]
             dist = [np.linalg.norm(rest[inner, None, :2] - rest[None, ids[self.owner[ids] == p], :2],
                                    axis=2).min(axis=1) for p in side]
@@ -217,10 +231,53 @@ class RigidBodySolver:
             vert += [inner, inner]
             panel += [np.full(len(inner), side[0]), np.full(len(inner), side[1])]
             weight += [1.0 - f, f]
+            side_weight[free_index[inner]] = np.column_stack([1.0 - f, f])
         self.carry_vert = np.concatenate(vert) if vert else np.zeros(0, dtype=np.int64)
         self.carry_panel = np.concatenate(panel) if panel else np.zeros(0, dtype=np.int64)
         self.carry_weight = np.concatenate(weight) if weight else np.zeros(0)
         self.carry_slot = free_index[self.carry_vert]
+        self._init_strip_motion(free_index, side_weight)
+
+    def _init_strip_motion(self, free_index, side_weight) -> None:
+        """Per strip vertex, the weight of each of its crease's two panels' motions
+        (S, 8, 2) and its hinge-interior index (S, 8) (−1 on a panel): what
+        :mod:`foldcore.rigid_normal` builds the strip rows from."""
+        owner = self.owner[self.ids]
+        alpha = np.stack([(owner == self.strip_side[:, b, None]).astype(float)
+                          for b in range(2)], axis=2)
+        stray = (owner >= 0) & (alpha.sum(axis=2) == 0)
+        if stray.any():
+            raise SimulationError(f"solver 'rigid': hinge sub-strip "
+                                  f"{int(np.flatnonzero(stray.any(axis=1))[0])} touches a "
+                                  "panel that is not one of its crease's two")
+        self.strip_free = free_index[self.ids]
+        inner = self.strip_free >= 0
+        alpha[inner] = side_weight[self.strip_free[inner]]
+        self.strip_alpha = alpha
+        self._crease_rounds()
+
+    def _crease_rounds(self) -> None:
+        """Creases (strips grouped by source crease, CSR) in rounds of creases that share
+        no panel (greedy colouring), so each round assembles in parallel."""
+        source = self.hinges.group.source
+        order = np.argsort(source, kind="stable")
+        creases, first = np.unique(source[order], return_index=True)
+        sides = self.strip_side[order[first]]
+        used: dict = {}  # panel → colours of its creases so far
+        colour = np.zeros(len(creases), dtype=np.int64)
+        for c, (left, right) in enumerate(sides):
+            taken = used.setdefault(left, set()) | used.setdefault(right, set())
+            colour[c] = next(k for k in range(len(taken) + 1) if k not in taken)
+            used[left].add(colour[c])
+            used[right].add(colour[c])
+        by_colour = np.argsort(colour, kind="stable")
+        bounds = np.append(first, len(order))
+        sizes = np.diff(bounds)[by_colour]
+        self.crease_ptr = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
+        self.crease_strips = np.concatenate([order[bounds[c]:bounds[c + 1]] for c in by_colour]) \
+            .astype(np.int64)
+        self.rounds = np.searchsorted(colour[by_colour], np.arange(colour.max() + 2)) \
+            .astype(np.int64)
 
     def _init_mv_sides(self, mesh, pattern) -> None:
         """M/V creases whose panels' dihedral is held on the assigned side (one-sided rows).
@@ -305,6 +362,78 @@ class RigidBodySolver:
         self.n_unknowns = self.phi_col + self.n_folds
         self._passive = passive.copy()
         self._map_pattern()
+        self._strip_layout()
+        self._normal_pattern()
+
+    def _strip_layout(self) -> None:
+        """Local columns of each strip for :mod:`foldcore.rigid_normal`: its crease's
+        moving panels (6 each), its hinge-interior vertices (3 each), its rotation
+        (3), its crease's angle (1, passive creases only)."""
+        s = len(self.ids)
+        pcol = self.panel_col[self.strip_side]  # (S, 2)
+        moving = pcol >= 0
+        # blocks in increasing global column (rigid_normal's scatter walks columns in order)
+        right_first = moving.all(axis=1) & (pcol[:, 1] < pcol[:, 0])
+        first = np.where(right_first, 6 * moving[:, 1], 0)
+        self.off_panel = np.where(moving, np.column_stack([first, 6 * (moving[:, 0] & ~right_first)]),
+                                  -1).astype(np.int64)
+        base = 6 * moving.sum(axis=1)
+        inner = self.strip_free >= 0
+        key = np.where(inner, self.strip_free, -1)
+        rank = (inner[:, None, :] & (key[:, None, :] < key[:, :, None])).sum(axis=2)
+        self.own_off = np.where(inner, base[:, None] + 3 * rank, -1).astype(np.int64)
+        self.off_w = (base + 3 * inner.sum(axis=1)).astype(np.int64)
+        fold_of = np.full(s, -1, dtype=np.int64)
+        fold_of[self.passive_ids] = self.passive_of
+        self.off_phi = np.where(fold_of >= 0, self.off_w + 3, -1).astype(np.int64)
+        self.n_loc = (self.off_w + 3 + (fold_of >= 0)).astype(np.int64)
+        cols = np.full((s, rigid_normal.MAX_LOCAL), -1, dtype=np.int64)
+        kind = np.full((s, rigid_normal.MAX_LOCAL), -1, dtype=np.int64)
+        rows = np.arange(s)
+        for b in range(2):
+            on = moving[:, b]
+            for d in range(6):
+                cols[rows[on], self.off_panel[on, b] + d] = pcol[on, b] + d
+                if d >= 3:
+                    kind[rows[on], self.off_panel[on, b] + d] = rigid_normal.TRANSLATION + d - 3
+        strip, k = np.nonzero(inner)
+        for d in range(3):
+            cols[strip, self.own_off[strip, k] + d] = self.free_col[self.strip_free[strip, k]] + d
+            kind[strip, self.own_off[strip, k] + d] = rigid_normal.TRANSLATION + d
+            cols[rows, self.off_w + d] = self.rot_col + 3 * rows + d
+            kind[rows, self.off_w + d] = rigid_normal.ROTATION + d
+        on = fold_of >= 0
+        cols[rows[on], self.off_phi[on]] = self.phi_col + fold_of[on]
+        self.loc_cols, self._loc_kind = cols, kind
+
+    def _normal_pattern(self) -> None:
+        """Fixed CSC pattern of JᵀJ (rigid_normal's module docstring): indptr, indices,
+        the slot of each diagonal entry; and a Factor to be refilled every step.
+
+        Blocks beside the strips': each column's diagonal, each moving panel's
+        6 × 6 block (position targets), each M/V crease's two panel rotations.
+        """
+        n = self.n_unknowns
+        width = rigid_normal.MAX_LOCAL
+        panel = self.panel_col[self.panel_col >= 0]
+        left, right = self.panel_col[self.mv_left], self.panel_col[self.mv_right]
+        both = (left >= 0) & (right >= 0)
+        blocks = [(np.arange(n)[:, None], 1),
+                  (panel[:, None] + np.arange(6), 6),
+                  (np.column_stack([left[both, None] + np.arange(3),
+                                    right[both, None] + np.arange(3)]), 6)]
+        cols, n_loc, kind = [self.loc_cols], [self.n_loc], [self._loc_kind]
+        for block, size in blocks:
+            padded = np.full((len(block), width), -1, dtype=np.int64)
+            padded[:, :size] = block
+            cols.append(padded)
+            n_loc.append(np.full(len(block), size, dtype=np.int64))
+            kind.append(np.full((len(block), width), -1, dtype=np.int64))
+        self.csc_indptr, self.csc_indices = rigid_normal.pattern_csc(
+            np.concatenate(n_loc), np.concatenate(cols), np.concatenate(kind), n)
+        column = np.repeat(np.arange(n), np.diff(self.csc_indptr))
+        self.diag_slot = np.flatnonzero(self.csc_indices == column)
+        self._normal_factor = None
 
     def _map_pattern(self) -> None:
         """COO pattern of P = ∂x/∂(panel, free-vertex unknowns), (3N, n_q).
@@ -351,9 +480,14 @@ class RigidBodySolver:
         shapes(g.indptr, g.rest, self.hinges.params, phi, self.shape, self.d_shape)
 
     def _residual(self, x, rot_e):
-        xe = x[self.ids]
-        xc = xe - xe.mean(axis=1, keepdims=True)
-        return self.sqrt_w[:, None, None] * (xc - self._targets(rot_e))
+        """(S, 8, 3) strip rows √w (x_k − x̄ − R_e t_k); the targets R_e t_k are kept in
+        ``self._strip_targets``."""
+        s = len(self.ids)
+        self._strip_targets = np.empty((s, 8, 3))
+        residual = np.empty((s, 8, 3))
+        rigid_normal.strip_rows(self.ids, x, rot_e, self.shape.reshape(-1, 8, 3), self.sqrt_w,
+                                self._strip_targets, residual)
+        return residual
 
     def _pin_terms(self):
         """Position targets as (vertex ids (n,), √weights (n,), positions (n, 3)), or None."""
@@ -434,12 +568,9 @@ class RigidBodySolver:
         """Spread each passive crease's angle evenly over its sub-strips (one arc)."""
         phi[self.passive_ids] = folds[self.passive_of] / self.k_strip[self.passive_ids]
 
-    def _jacobian(self, state: State):
-        """Sparse J (rows: strip residuals then pins; columns: the unknowns) and r."""
-        residual = self._residuals(state)
-        x, rot_e = state.x, state.rot_e
-        targets = self._targets(rot_e)
-        a = x[self._m_vert] - state.c_p[self._m_panel]
+    def _position_map(self, state: State):
+        """P = ∂x/∂(panel, free-vertex unknowns) at a state, sparse (3N, n_q)."""
+        a = state.x[self._m_vert] - state.c_p[self._m_panel]
         w = self._m_weight
         minus_skew = -skew(a) * w[:, None, None]
         p_vals = []
@@ -447,8 +578,61 @@ class RigidBodySolver:
             p_vals += [minus_skew[:, d, c] for c in range(3)] + [w]
         p_vals += [np.ones(len(self.free))] * 3
         n = self.sim.mesh.n_vertices
-        p_map = sp.csr_matrix((np.concatenate(p_vals), (self._p_rows, self._p_cols)),
-                              shape=(3 * n, self._n_q))
+        return sp.csr_matrix((np.concatenate(p_vals), (self._p_rows, self._p_cols)),
+                             shape=(3 * n, self._n_q))
+
+    def _angle_columns(self, rot_e) -> np.ndarray:
+        """(S, 8, 3) ∂(R T_k)/∂(crease angle) of passive strips (−R ∂T_k/∂φ / k), 0 else."""
+        pas = self.passive_ids
+        out = np.zeros((len(self.ids), 8, 3))
+        out[pas] = np.einsum("sij,skj->ski", rot_e[pas], self.d_shape.reshape(-1, 8, 3)[pas]) \
+            * (-1.0 / self.k_strip[pas])[:, None, None]
+        return out
+
+    def _extra_rows(self, state: State):
+        """Sparse Jacobian of the rows after the strips' (position targets, then M/V side
+        rows), or None when there are none."""
+        parts = []
+        pins = self._pin_rows()
+        if pins is not None:
+            n_hinge = 3 * len(self.ids) + self.n_folds
+            parts.append(sp.hstack([pins @ self._position_map(state),
+                                    sp.csr_matrix((pins.shape[0], n_hinge))]))
+        if len(self.mv_sign):
+            parts.append(self._mv_rows(state.rot_p, self.n_unknowns))
+        return sp.vstack(parts).tocsr() if parts else None
+
+    def _linearise(self, state: State) -> "Linearisation":
+        """JᵀJ (values on the fixed pattern), Jᵀr and r at a state, without forming J for
+        the strips (:mod:`foldcore.rigid_normal`)."""
+        residual = self._residuals(state)
+        s = len(self.ids)
+        lin = Linearisation(self, state, residual, self._strip_targets,
+                            self._angle_columns(state.rot_e), self._extra_rows(state))
+        data = np.zeros(len(self.csc_indices))
+        lin.grad = np.zeros(self.n_unknowns)
+        missing = rigid_normal.assemble(
+            *lin.strip_args[:9], self.n_loc, self.loc_cols, *lin.strip_args[10:13],
+            residual[:24 * s].reshape(s, 8, 3), self.rounds, self.crease_ptr, self.crease_strips,
+            self.csc_indptr, self.csc_indices, data, lin.grad)
+        if lin.extra is not None:
+            lin.grad += lin.extra.T @ residual[24 * s:]
+            coo = (lin.extra.T @ lin.extra).tocoo()
+            missing += rigid_normal.add_entries(self.csc_indptr, self.csc_indices, data,
+                                                coo.row.astype(np.int64),
+                                                coo.col.astype(np.int64), coo.data)
+        if missing:
+            raise SimulationError(f"solver 'rigid': {missing} normal-matrix entries outside "
+                                  "the layout's pattern (a bug: please report it)")
+        lin.normal = data
+        return lin
+
+    def _jacobian(self, state: State):
+        """Sparse J (rows: strip residuals, pins, M/V rows) and r: the reference the
+        assembled normal equations are tested against (not used by the step)."""
+        residual = self._residuals(state)
+        rot_e = state.rot_e
+        targets = self._targets(rot_e)
         s = len(self.ids)
         jr = (self.sqrt_w[:, None, None, None] * skew(targets)).reshape(s, 24, 3)
         rows_r = np.arange(24 * s).reshape(s, 24)
@@ -458,18 +642,13 @@ class RigidBodySolver:
                                                     + np.arange(3), (s, 24, 3)).ravel())),
                                   shape=(24 * s, 3 * s))
         pas = self.passive_ids
-        d_t = np.einsum("sij,skj->ski", rot_e[pas], self.d_shape.reshape(-1, 8, 3)[pas])
-        scale = -self.sqrt_w[pas] / self.k_strip[pas]
-        phi_block = sp.csr_matrix(((scale[:, None, None] * d_t).ravel(),
+        d_t = self._angle_columns(rot_e)[pas] * self.sqrt_w[pas, None, None]
+        phi_block = sp.csr_matrix((d_t.ravel(),
                                    (rows_r[pas].ravel(), np.repeat(self.passive_of, 24))),
                                   shape=(24 * s, self.n_folds))
-        pins = self._pin_rows()
-        jx = self.jx if pins is None else sp.vstack([self.jx, pins]).tocsr()
-        zero = sp.csr_matrix((jx.shape[0] - 24 * s, 3 * s + self.n_folds))
-        hinge_cols = sp.vstack([sp.hstack([rot_block, phi_block]), zero])
-        jac = sp.hstack([jx @ p_map, hinge_cols])
-        if len(self.mv_sign):
-            jac = sp.vstack([jac, self._mv_rows(state.rot_p, jac.shape[1])])
+        strips = sp.hstack([self.jx @ self._position_map(state), rot_block, phi_block])
+        extra = self._extra_rows(state)
+        jac = strips if extra is None else sp.vstack([strips, extra])
         return jac.tocsc(), residual
 
     def step(self) -> tuple[float, float]:
@@ -496,14 +675,16 @@ class RigidBodySolver:
         self._read_targets()
         self._update_shapes(self.phi)
         if not self._fitted:  # strips' rotations start at their exact fit
-            self.rot_e = procrustes(self.x[self.ids], self.shape.reshape(-1, 8, 3))
+            self.rot_e = np.empty((len(self.ids), 3, 3))
+            rigid_normal.fit_strip_rotations(self.ids, self.x, self.shape.reshape(-1, 8, 3),
+                                             self.rot_e)
             self._fitted = True
         start = self._state()
-        jac, res = self._jacobian(start)
+        lin = self._linearise(start)
+        res, grad = lin.residual, lin.grad
         energy = float(res @ res)
-        grad = jac.T @ res
         t0 = time.perf_counter()
-        factor = self._factor(jac, grad)
+        factor = self._factor(lin.normal, grad)
         velocity = factor.solve(-grad)
         self.solve_time += time.perf_counter() - t0
         trial = self._apply(start, velocity)
@@ -511,9 +692,9 @@ class RigidBodySolver:
             h = GEODESIC_H
             probe = self._apply(start, h * velocity)
             res_h = self._residuals(probe)
-            r_vv = 2.0 / h * ((res_h - res) / h - jac @ velocity)
+            r_vv = 2.0 / h * ((res_h - res) / h - lin.apply(velocity))
             t0 = time.perf_counter()
-            accel = factor.solve(-(jac.T @ r_vv))
+            accel = factor.solve(-lin.apply_transpose(r_vv))
             self.solve_time += time.perf_counter() - t0
             if np.linalg.norm(accel) <= GEODESIC_MAX * np.linalg.norm(velocity):
                 trial = self._apply(start, velocity + 0.5 * accel)
@@ -521,23 +702,32 @@ class RigidBodySolver:
         new_energy = self._trial_energy(trial)
         if new_energy <= energy:
             self._set_state(trial)
-            self.lam = max(self.lam / 3.0, LAMBDA_MIN)
+            self.lam = max(self.lam / LAMBDA_DOWN, LAMBDA_MIN)
         else:
             self._update_shapes(self.phi)  # restore the shapes of the kept angles
-            self.lam = min(self.lam * 5.0, LAMBDA_MAX)
+            self.lam = min(self.lam * LAMBDA_UP, LAMBDA_MAX)
         return energy, moved
 
-    def _factor(self, jac, grad) -> Factor:
-        """Factorisation of JᵀJ + λ·diag(JᵀJ), angles on a bound they press against frozen."""
-        normal = (jac.T @ jac).tocsc()
-        diag = np.maximum(normal.diagonal(), 1e-12 * max(normal.diagonal().max(), 1e-300))
+    def _factor(self, normal: np.ndarray, grad) -> Factor:
+        """Factorisation of JᵀJ + λ·diag(JᵀJ) (values ``normal`` on the fixed pattern),
+        angles on a bound they press against frozen; the symbolic analysis is reused."""
+        diag = normal[self.diag_slot]
+        diag = np.maximum(diag, 1e-12 * max(diag.max(), 1e-300))
         folds = self._folds(self.phi)
         g_fold = grad[self.phi_col:]
         blocked = ((folds <= self.lo + BOUND_TOL) & (g_fold > 0)) | \
                   ((folds >= self.hi - BOUND_TOL) & (g_fold < 0))
         damping = self.lam * diag
         damping[self.phi_col:][blocked] = 1e12 * diag[self.phi_col:][blocked]
-        return Factor(normal + sp.diags(damping), self.backend)
+        values = normal.copy()
+        values[self.diag_slot] += damping
+        n = self.n_unknowns
+        matrix = sp.csc_matrix((values, self.csc_indices, self.csc_indptr), shape=(n, n))
+        if self._normal_factor is None:
+            self._normal_factor = Factor(matrix, self.backend)
+        else:
+            self._normal_factor.refactor(matrix)
+        return self._normal_factor
 
     def _state(self) -> State:
         return State(self.x, self.rot_p, self.c_p, self.y, self.rot_e, self.phi)
@@ -562,14 +752,9 @@ class RigidBodySolver:
 
     def _carry(self, state: State, rot_p, c_p) -> np.ndarray:
         """Free vertices moved by the blend of their panels' rigid motions (old → new)."""
-        y = np.zeros_like(state.y)
-        p, slot = self.carry_panel, self.carry_slot
-        a = state.y[slot] - state.c_p[p]
-        relative = rot_p[p] @ np.transpose(state.rot_p[p], (0, 2, 1))
-        moved = np.einsum("nij,nj->ni", relative, a) + c_p[p]
-        for d in range(3):
-            y[:, d] = np.bincount(slot, weights=self.carry_weight * moved[:, d],
-                                  minlength=len(y))
+        y = np.empty_like(state.y)
+        rigid_normal.carry_free(self.carry_slot, self.carry_panel, self.carry_weight, state.y,
+                                state.c_p, state.rot_p, rot_p, c_p, y)
         return y
 
     def _move_panels(self, state: State, w):
@@ -596,7 +781,44 @@ class RigidBodySolver:
     def _trial_energy(self, state: State) -> float:
         """Energy of a trial state after refitting its strips' rotations (Procrustes)."""
         self._update_shapes(state.phi)
-        state.rot_e[:] = procrustes(state.x[self.ids], self.shape.reshape(-1, 8, 3))
+        rigid_normal.fit_strip_rotations(self.ids, state.x, self.shape.reshape(-1, 8, 3),
+                                         state.rot_e)
         residual = self._residuals_at_shapes(state)
         strips = 24 * len(self.ids)  # summed as before: the accept test is at rounding level
         return float((residual[:strips] ** 2).sum() + (residual[strips:] ** 2).sum())
+
+
+class Linearisation:
+    """The step's linear model at one state: r, Jᵀr, JᵀJ's values, and J·v / Jᵀu.
+
+    The strips' rows come from :mod:`foldcore.rigid_normal` (no J is formed);
+    the few rows after them (position targets, M/V side rows) are a small
+    sparse matrix ``extra``.
+    """
+
+    def __init__(self, solver: RigidBodySolver, state: State, residual, targets, d_targets,
+                 extra):
+        self.residual, self.extra = residual, extra
+        self.n_strip_rows = 24 * len(solver.ids)
+        self.n_unknowns = solver.n_unknowns
+        self.strip_args = (solver.ids, state.x, state.c_p, solver.strip_side, solver.off_panel,
+                           solver.strip_alpha, solver.own_off, solver.off_w, solver.off_phi,
+                           solver.loc_cols, solver.sqrt_w, targets, d_targets)
+        self.grad = self.normal = None
+
+    def apply(self, v: np.ndarray) -> np.ndarray:
+        """J·v (rows as the residual) for an increment v (n_unknowns,)."""
+        out = np.empty((self.n_strip_rows // 24, 8, 3))
+        rigid_normal.apply_jacobian(*self.strip_args, v, out)
+        if self.extra is None:
+            return out.ravel()
+        return np.concatenate([out.ravel(), self.extra @ v])
+
+    def apply_transpose(self, u: np.ndarray) -> np.ndarray:
+        """Jᵀ·u (n_unknowns,) for row values u (rows as the residual)."""
+        grad = np.zeros(self.n_unknowns)
+        m = self.n_strip_rows
+        rigid_normal.apply_transpose(*self.strip_args, u[:m].reshape(-1, 8, 3), grad)
+        if self.extra is not None:
+            grad += self.extra.T @ u[m:]
+        return grad
