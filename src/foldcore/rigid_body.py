@@ -45,7 +45,9 @@ from .measure import best_rotations
 SEED = 1e-2          # rad: pre-bend of a passive M/V strip that starts flat
 LAMBDA_START = 1e-4  # initial Levenberg–Marquardt damping (relative to diag of JᵀJ)
 LAMBDA_MIN, LAMBDA_MAX = 1e-12, 1e12
+LAMBDA_SETTLED = 1.0  # largest damping of an accepted step that may end a run
 LAMBDA_DOWN, LAMBDA_UP = 3.0, 5.0  # damping divided after an accepted step, multiplied after a rejected one
+ROUNDING = 64 * np.finfo(float).eps  # relative energy change that is rounding noise
 BOUND_TOL = 1e-12    # rad: a bounded angle this close to its bound is on it
 GEODESIC_H = 0.1     # finite-difference step of the geodesic acceleration (fraction of the step)
 GEODESIC_MAX = 1.5   # acceleration kept only if |a| ≤ this × |v|
@@ -128,6 +130,8 @@ class RigidBodySolver:
         self._init_strips(sim._hinges)
         self._init_mv_sides(mesh, sim.pattern)
         self.lam = LAMBDA_START
+        self.accepted, self.energy, self.decrease = False, np.inf, np.inf  # the last step's
+        self.energy_scale = 0.0
         self._passive = None
         self._fitted = False
         self.solve_time = 0.0  # s spent factorising and solving (the rest is assembly)
@@ -700,13 +704,54 @@ class RigidBodySolver:
                 trial = self._apply(start, velocity + 0.5 * accel)
         moved = float(np.abs(trial.x - self.x).max())
         new_energy = self._trial_energy(trial)
-        if new_energy <= energy:
+        self.accepted, self.step_lam = new_energy <= energy, self.lam
+        if self.accepted:
             self._set_state(trial)
             self.lam = max(self.lam / LAMBDA_DOWN, LAMBDA_MIN)
+            self.decrease = energy - new_energy
         else:
             self._update_shapes(self.phi)  # restore the shapes of the kept angles
             self.lam = min(self.lam * LAMBDA_UP, LAMBDA_MAX)
+            self.decrease = energy - new_energy  # < 0
+        self.energy = energy
+        self.energy_scale = max(self.energy_scale, energy)
         return energy, moved
+
+    def new_run(self) -> None:
+        """A run starts: its energy scale (see :meth:`settled`) and the damping start
+        afresh (a damping saturated at the end of the last run would make the new
+        run's first steps crawl, and look settled)."""
+        self.energy_scale = 0.0
+        self.lam = LAMBDA_START
+
+    def settled(self, moved: float, tolerance: float) -> bool:
+        """Whether the last step ends a run at relative ``tolerance``: it was accepted,
+        moved ≤ tolerance × the pattern's size, and lowered the energy by ≤ tolerance
+        × the energy.
+
+        Why the energy too: a step's length alone is met by a stall. A thin Miura
+        50 × 50 (H = 0.02 mm, size 1 010 mm) crept out of the flat state in steps
+        of 1e-5 … 1e-3 mm for 100 iterations, each lowering E by far more than
+        1e-8 E, and stopped "converged" 60° short at a 7.7e-6 mm step (limit
+        1.0e-5 mm); its branch stage had stopped after 2 steps the same way.
+        Where the energy vanishes (compatible targets) its decrease is rounding
+        noise of the order of E itself, hence the floor tolerance² × the largest
+        energy of the run (``energy_scale``, reset by :meth:`new_run`). A
+        rejected step ends a run only there, where its energy rose by no more
+        than rounding (``ROUNDING`` × E), or where even the most damped step
+        (λ = ``LAMBDA_MAX``, a scaled gradient step of ~1e-14 mm) raised it: a
+        minimum no step can lower, e.g. the chain scene pushed against its stop,
+        where the energy has a kink (34 rejected steps from λ = 1e-4 to get there).
+        """
+        if moved > tolerance * self.sim.length_scale:
+            return False
+        floor = tolerance ** 2 * self.energy_scale
+        if self.accepted:  # a step damped to a crawl says nothing: λ must be small
+            return bool(self.decrease <= tolerance * self.energy + floor
+                        and self.step_lam <= LAMBDA_SETTLED)
+        # rejected: at the energy's rounding floor, or no descent at any damping
+        return bool(self.energy <= floor or -self.decrease <= ROUNDING * self.energy
+                    or self.step_lam >= LAMBDA_MAX)
 
     def _factor(self, normal: np.ndarray, grad) -> Factor:
         """Factorisation of JᵀJ + λ·diag(JᵀJ) (values ``normal`` on the fixed pattern),

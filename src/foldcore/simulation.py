@@ -236,6 +236,7 @@ class Simulation:
                                   f"{branch_floor_deg!r}")
         self.branch_floor_deg = float(branch_floor_deg)
         self.branch_iterations = 0  # iterations spent in branch stages (run docstring)
+        self.runs = 0  # calls of run so far (a run's stages share one number)
         self._targets = np.zeros((offset, 3))
         # column-major: CHOLMOD's own layout, so the solve copies nothing in
         self._rhs = np.zeros((mesh.n_vertices, 3), order="F")
@@ -463,29 +464,31 @@ class Simulation:
             threads (:mod:`foldcore.threads`).
         """
         start = time.perf_counter()
+        self.runs += 1
         self.timings.setdefault("total", self.timings["setup"])
         budget, limit = int(max_iterations), tolerance * self.length_scale
-        moved, stopped = np.inf, False
+        settled = stopped = False
         with blas_on_one_thread(self.threads > 1):
             if self._starts_flat():
-                used, moved, stopped = self._branch_stage(budget, callback, limit)
+                used, settled, stopped = self._branch_stage(budget, callback, limit)
                 budget -= used
+                settled = False  # the released stage has yet to settle
             if budget > 0 and not stopped:
-                _, moved, stopped = self._stage(budget, callback, limit)
+                _, settled, stopped = self._stage(budget, callback, limit)
         self.timings["total"] += time.perf_counter() - start
         self.timings["bare_solve"] = self._bare_solve_floor()
-        return self.result(not stopped and moved <= limit)
+        return self.result(settled and not stopped)
 
-    def _stage(self, budget: int, callback, limit: float) -> tuple[int, float, bool]:
+    def _stage(self, budget: int, callback, limit: float) -> tuple[int, bool, bool]:
         """One bracketed stretch of strategy steps (:meth:`_iterate`); returns
-        (steps taken, last move mm, whether the callback stopped)."""
+        (steps taken, whether the strategy settled, whether the callback stopped)."""
         before = self.iterations
         self.strategy.begin_run()
         try:
-            moved, stopped = self._iterate(budget, callback, limit)
+            settled, stopped = self._iterate(budget, callback, limit)
         finally:
             self.strategy.end_run()
-        return self.iterations - before, moved, stopped
+        return self.iterations - before, settled, stopped
 
     def _starts_flat(self) -> bool:
         """Whether this run needs the branch stage: a floor is set, some passive crease
@@ -518,20 +521,20 @@ class Simulation:
         self.branch_iterations += result[0]
         return result
 
-    def _iterate(self, budget: int, callback, limit: float) -> tuple[float, bool]:
-        """Up to ``budget`` steps, until the strategy is settled (a step moved ≤
+    def _iterate(self, budget: int, callback, limit: float) -> tuple[bool, bool]:
+        """Up to ``budget`` steps, until the strategy is settled (e.g. a step moved ≤
         ``limit`` mm, :meth:`Strategy.settled`) or the callback says stop; returns
-        (the last step's move in mm, whether the callback stopped)."""
-        moved = np.inf
+        (whether the strategy settled, whether the callback stopped). A run whose
+        budget ends is not settled, however small its last step."""
         for _ in range(budget):
             moved = self._step()
             if not np.isfinite(moved):
                 raise SimulationError("the iteration produced non-finite positions")
             if callback is not None and callback(self, moved) is False:
-                return moved, True
+                return False, True
             if self.strategy.settled(moved, limit):
-                break
-        return moved, False
+                return True, False
+        return False, False
 
     def _bare_solve_floor(self) -> float:
         """:meth:`bare_solve_seconds`, timed once per factorisation of K (a sweep of

@@ -45,6 +45,7 @@ class Hybrid(Strategy):
         self.rigid = None  # the rigid phase's strategy while it runs
         self._rigid_steps = 0
         self._pending = True  # the next run starts with a rigid phase
+        self._energy_scale = (-1, 0.0)  # (run, largest rigid-phase energy): its stages share it
 
     @property
     def phase(self) -> str:
@@ -60,7 +61,11 @@ class Hybrid(Strategy):
             self.rigid = Rigid(self.sim)
         except SimulationError:
             self.rigid = None  # not a rigid-panel mesh: L-BFGS alone
+            return
         self._rigid_steps = 0
+        self.rigid.begin_run()
+        if self._energy_scale[0] == self.sim.runs:  # a later stage of the same run
+            self.rigid.engine.energy_scale = self._energy_scale[1]
 
     def step(self) -> tuple[float, float]:
         if self.rigid is None:
@@ -69,9 +74,11 @@ class Hybrid(Strategy):
         return self.rigid.step()
 
     def settled(self, moved: float, limit: float) -> bool:
-        done = super().settled(moved, limit)
-        if self.rigid is not None and (done or moved <= HYBRID_RIGID_TOL * self.sim.length_scale
-                                       or self._rigid_steps >= HYBRID_RIGID_MAX):
+        if self.rigid is None:
+            return super().settled(moved, limit)
+        done = self.rigid.settled(moved, limit)
+        tiny = self.rigid.engine.accepted and moved <= HYBRID_RIGID_TOL * self.sim.length_scale
+        if done or tiny or self._rigid_steps >= HYBRID_RIGID_MAX:
             self._leave_rigid_phase()
         return done
 
@@ -81,6 +88,7 @@ class Hybrid(Strategy):
     def _leave_rigid_phase(self) -> None:
         if self.rigid is None:
             return
+        self._energy_scale = (self.sim.runs, self.rigid.engine.energy_scale)
         self.rigid = None
         self.sim.x = np.ascontiguousarray(self.sim.x.copy())
         self.lbfgs.restart()

@@ -24,6 +24,7 @@ class Rigid(Strategy):
 
         super().__init__(sim)
         self.engine = RigidBodySolver(sim)  # SimulationError on meshes it cannot take
+        self._run = -1  # the Simulation.run the engine's energy scale belongs to
         sim.x = self.engine.x
 
     def step(self) -> tuple[float, float]:
@@ -37,6 +38,16 @@ class Rigid(Strategy):
         sim.timings["solve"] += solve
         sim.timings["projection"] += time.perf_counter() - t0 - solve
         return energy, moved
+
+    def begin_run(self) -> None:
+        if self._run != self.sim.runs:  # a new Simulation.run, not its second stage
+            self._run = self.sim.runs
+            self.engine.new_run()
+
+    def settled(self, moved: float, limit: float) -> bool:
+        """An accepted step, small in length and in energy decrease
+        (:meth:`RigidBodySolver.settled`): a stall does not end a run."""
+        return self.engine.settled(moved, limit / self.sim.length_scale)
 
     def positions_set(self) -> None:
         raise SimulationError("solver 'rigid' keeps its panels rigid by construction: "
