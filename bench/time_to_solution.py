@@ -196,6 +196,10 @@ def table(path: Path = RESULTS / "time_to_solution.json") -> str:
                 cells.append("–")
                 continue
             mark = "" if r["accurate"] else f", {r['error_deg']:.2g}° off"
+            if r["converged"] and not r["accurate"]:
+                mark += " yet “converged”"
+            elif not r["converged"]:
+                mark += ", not converged"
             cells.append(f"{r['seconds']:.3g} s, {r['iterations']} its{mark}")
         r = next(r for r in data["warm"] if r["case"] == case and r["strategy"] == "hybrid")
         cells += [f"{r['thick_vertices']:,}", f"{r['bare_solves']:,.0f}",

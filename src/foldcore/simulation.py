@@ -329,6 +329,19 @@ class Simulation:
         self._apply_fold_targets()
         self._targets_changed()
 
+    def predict(self, ratio: float) -> bool:
+        """Start the next run from the extrapolation of the last two converged runs:
+        state ≈ last + ``ratio`` × (last − the one before), rotations along their
+        geodesics — the predictor of a path in small increments (a fold-percent
+        sweep: ratio = Δpercent_next / Δpercent_last, :func:`foldcore.animate.fold_sweep`).
+
+        Only the rigid-body strategies (``rigid``, ``hybrid`` after a rigid phase
+        that converged) keep those states; returns whether the state moved.
+        """
+        if not np.isfinite(ratio):
+            raise SimulationError(f"predict: ratio must be finite, got {ratio!r}")
+        return bool(self.strategy.predict(float(ratio)))
+
     def add_position_target(self, vertices, positions=None, alpha: float = 1.0,
                             decay: float = 1.0, name: str | None = None) -> str:
         """Pull vertices toward positions (mm); returns the target's name.

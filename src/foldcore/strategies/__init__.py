@@ -99,6 +99,12 @@ class Strategy:
     def restart(self) -> None:
         """Continue from ``sim.x`` with no memory of earlier steps."""
 
+    def predict(self, ratio: float) -> bool:
+        """Move ``sim.x`` to the extrapolation ``ratio`` × the step between the last
+        two converged runs (a path's predictor, :meth:`Simulation.predict`);
+        returns whether it did (default: never)."""
+        return False
+
     @property
     def phase(self) -> str:
         """Name of the strategy that takes the next step (a composite's current phase)."""

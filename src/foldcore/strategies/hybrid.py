@@ -1,7 +1,8 @@
 """``hybrid``: rigid-body steps first, L-BFGS where they cannot finish (a composite).
 
 Each :meth:`Simulation.run` starts with a rigid phase (:mod:`.rigid`) from
-the current positions. A rigid step that moves ≤ the run's tolerance ×
+the current positions (one rigid-body engine serves every run: its column
+layout and factor analysis are built once). A rigid step that moves ≤ the run's tolerance ×
 size ends the run there: the rigid-body model's equilibrium (panels exactly
 rigid, each passive crease one bounded bend). Otherwise the phase ends when
 a step moves ≤ ``HYBRID_RIGID_TOL`` × size (a run with a tighter tolerance,
@@ -45,7 +46,7 @@ class Hybrid(Strategy):
         self.rigid = None  # the rigid phase's strategy while it runs
         self._rigid_steps = 0
         self._pending = True  # the next run starts with a rigid phase
-        self._energy_scale = (-1, 0.0)  # (run, largest rigid-phase energy): its stages share it
+        self._engine = None  # the rigid phase's strategy, built on the first run (False: none)
 
     @property
     def phase(self) -> str:
@@ -57,15 +58,18 @@ class Hybrid(Strategy):
         self._pending = False
         if any(t.decay < 1.0 for t in self.sim._position_targets.values()):
             return  # a pull-and-release schedule: the rigid phase would settle before it fades
-        try:
-            self.rigid = Rigid(self.sim)
-        except SimulationError:
-            self.rigid = None  # not a rigid-panel mesh: L-BFGS alone
+        if self._engine is None:
+            try:
+                self._engine = Rigid(self.sim)
+            except SimulationError:
+                self._engine = False  # not a rigid-panel mesh: L-BFGS alone
+        if self._engine is False:
             return
+        self.rigid = self._engine  # one engine for every run: its layout and analysis stay
+        self.rigid.engine.resync(self.sim.x)
+        self.sim.x = self.rigid.engine.x
         self._rigid_steps = 0
-        self.rigid.begin_run()
-        if self._energy_scale[0] == self.sim.runs:  # a later stage of the same run
-            self.rigid.engine.energy_scale = self._energy_scale[1]
+        self.rigid.begin_run()  # a run's stages share its energy scale (rigid_body.settled)
 
     def step(self) -> tuple[float, float]:
         if self.rigid is None:
@@ -79,8 +83,16 @@ class Hybrid(Strategy):
         done = self.rigid.settled(moved, limit)
         tiny = self.rigid.engine.accepted and moved <= HYBRID_RIGID_TOL * self.sim.length_scale
         if done or tiny or self._rigid_steps >= HYBRID_RIGID_MAX:
+            if not done:  # L-BFGS takes over: the run will not end at a rigid state
+                self.rigid.engine.forget_ends()
             self._leave_rigid_phase()
         return done
+
+    def predict(self, ratio: float) -> bool:
+        if not self._engine or not self._engine.predict(ratio):
+            return False
+        self.lbfgs.restart()
+        return True
 
     def end_run(self) -> None:
         self._leave_rigid_phase()
@@ -88,7 +100,6 @@ class Hybrid(Strategy):
     def _leave_rigid_phase(self) -> None:
         if self.rigid is None:
             return
-        self._energy_scale = (self.sim.runs, self.rigid.engine.energy_scale)
         self.rigid = None
         self.sim.x = np.ascontiguousarray(self.sim.x.copy())
         self.lbfgs.restart()
@@ -99,6 +110,8 @@ class Hybrid(Strategy):
 
     def positions_set(self) -> None:
         self._leave_rigid_phase()
+        if self._engine:
+            self._engine.engine.forget_ends()
         self._pending = False
         self.lbfgs.restart()
 

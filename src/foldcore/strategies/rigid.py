@@ -46,8 +46,18 @@ class Rigid(Strategy):
 
     def settled(self, moved: float, limit: float) -> bool:
         """An accepted step, small in length and in energy decrease
-        (:meth:`RigidBodySolver.settled`): a stall does not end a run."""
-        return self.engine.settled(moved, limit / self.sim.length_scale)
+        (:meth:`RigidBodySolver.settled`): a stall does not end a run. A settled
+        state is kept for :meth:`predict`."""
+        done = self.engine.settled(moved, limit / self.sim.length_scale)
+        if done:
+            self.engine.record_end()
+        return done
+
+    def predict(self, ratio: float) -> bool:
+        if not self.engine.predict(ratio):
+            return False
+        self.sim.x = self.engine.x
+        return True
 
     def positions_set(self) -> None:
         raise SimulationError("solver 'rigid' keeps its panels rigid by construction: "
