@@ -213,7 +213,7 @@ class RigidBodySolver:
         self.rot_e = np.tile(np.eye(3), (s, 1, 1))
 
     def _sync_weights(self) -> None:
-        """Strip weights (√w) and the position Jacobian from the Simulation's current
+        """Strip weights (√w) from the Simulation's current
         weights (actuation and stops change them: ``System.set_weights`` stores a
         new array, so a different array is the sign)."""
         weights = self.sim.system.weights[self.sim._hinge_index]
@@ -221,7 +221,6 @@ class RigidBodySolver:
             return
         self._weights_read = weights
         self.sqrt_w = np.sqrt(weights)
-        self.jx = self._strip_position_jacobian()
 
     def _init_carriers(self, mesh, pattern) -> None:
         """Blend weights that carry each free (hinge-interior) vertex with its two panels.
@@ -666,7 +665,8 @@ class RigidBodySolver:
         phi_block = sp.csr_matrix((d_t.ravel(),
                                    (rows_r[pas].ravel(), np.repeat(self.passive_of, 24))),
                                   shape=(24 * s, self.n_folds))
-        strips = sp.hstack([self.jx @ self._position_map(state), rot_block, phi_block])
+        strips = sp.hstack([self._strip_position_jacobian() @ self._position_map(state),
+                            rot_block, phi_block])
         extra = self._extra_rows(state)
         jac = strips if extra is None else sp.vstack([strips, extra])
         return jac.tocsc(), residual

@@ -2,11 +2,13 @@
 
 Each :meth:`Simulation.run` starts with a rigid phase (:mod:`.rigid`) from
 the current positions (one rigid-body engine serves every run: its column
-layout and factor analysis are built once). A rigid step that moves ≤ the run's tolerance ×
-size ends the run there: the rigid-body model's equilibrium (panels exactly
-rigid, each passive crease one bounded bend). Otherwise the phase ends when
-a step moves ≤ ``HYBRID_RIGID_TOL`` × size (a run with a tighter tolerance,
-e.g. 0) or after ``HYBRID_RIGID_MAX`` steps, and :mod:`.lbfgs` continues
+layout and factor analysis are built once). A rigid step that settles
+(:meth:`.rigid.Rigid.settled`: accepted, ≤ the run's tolerance × size and
+lowering the energy by ≤ tolerance × E) ends the run there: the rigid-body
+model's equilibrium (panels exactly rigid, each passive crease one bounded
+bend). Otherwise the phase ends when an accepted step moves ≤
+``HYBRID_RIGID_TOL`` × size (a run with a tighter tolerance, e.g. 0) or
+after ``HYBRID_RIGID_MAX`` steps, and :mod:`.lbfgs` continues
 from where it stopped on the paper's own energy (Eq. 9 passive sub-strips,
 panels as stiff elements). Why the run ends with the rigid phase when it
 settles (measured, issue 16): where the rigid phase converges the L-BFGS
