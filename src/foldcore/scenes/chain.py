@@ -31,14 +31,15 @@ from the last. The thick chain is not an exact zero-strain mechanism in the
 strained-joint model (hinge axes sit O(W) off the crease lines, issue 4), so
 the corner does not reach every commanded push: the achieved lengths are
 what is reported. The hinges' 180° limits stop the motion. Measured (rigid
-strategy): the deployed chain 23.5 × 122.0 mm (panel-centroid lengths),
-after the stop 8.7 × 79.4 mm from the 50 mm push on; every step converges
-in 1–84 iterations except the one just before the stop (45 mm), where the
-Gauss–Newton steps shrink linearly (a large residual: the corner is 18 mm
-from the soft push target) and the 400-iteration budget ends first. The
-state after the stop depends on where that unconverged step ends: a
-rounding-level change of the bent-strip arithmetic moved it from 79.2 to
-79.4 mm (every push up to 40 mm agreed to 1e-4 mm).
+strategy, 2026-12-02): the deployed chain 23.5 × 122.0 mm (panel-centroid
+lengths), after the stop 8.7 × 79.3 mm from the 50 mm push on; every step
+converges in 10–101 iterations except the one just before the stop (45 mm),
+where the Gauss–Newton steps shrink linearly (a large residual: the corner
+is 18 mm from the soft push target) and the 400-iteration budget ends
+first. The state after the stop depends on where that unconverged step
+ends: a rounding-level change of the bent-strip arithmetic moved it from
+79.2 to 79.4 mm, the rigid step's numba assembly and its energy-based
+verdict to 79.3 mm (every push up to 40 mm agreed to 1e-4 mm).
 
 Hinge model: the paper's constant-length arc (``HINGE``), not foldcore's
 default axis hinge (:mod:`foldcore.hinges`), because this scene reproduces
