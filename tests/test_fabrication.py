@@ -279,9 +279,22 @@ def _bad_export_inputs(result_fold, tmp_path):
     edited["file_frames"][0]["vertices_coords"] = edited["file_frames"][0]["vertices_coords"][:-1]
     short = tmp_path / "short.fold"
     short.write_text(json.dumps(edited))
+    variants = {}
+    for name, edit in (("huge", lambda f: f["vertices_coords"][3].__setitem__(0, 1e308)),
+                       ("classes", lambda f: f.__setitem__("frame_classes", 5)),
+                       ("unit", lambda f: f.__setitem__("frame_unit", ["mm"]))):
+        data = json.loads(result_fold.read_text())  # issue 18's reproducers
+        edit(data["file_frames"][0])
+        variants[name] = tmp_path / f"{name}.fold"
+        variants[name].write_text(json.dumps(data))
     svg, stl = str(tmp_path / "o.svg"), str(tmp_path / "o.stl")
     fold = str(result_fold)
     return {
+        "coordinate 1e308 (was a hang)": (["export", str(variants["huge"]), "--svg", svg],
+                                          "vertex 3"),
+        "frame_classes not a list": (["export", str(variants["classes"]), "--stl", stl],
+                                     "frame_classes"),
+        "frame_unit a list": (["export", str(variants["unit"]), "--stl", stl], "frame_unit"),
         "nothing asked": (["export", fold], "nothing to export"),
         "missing file": (["export", str(tmp_path / "nope.fold"), "--stl", stl], "nope.fold"),
         "not a result": (["export", str(plain), "--stl", stl], "no folded frame"),

@@ -428,6 +428,7 @@ def read_result(path, hinge_width=None, subdivisions=None) -> ResultFile:
     positions, faces = _folded_frame(d, source)
     if fold.thickness is None:
         raise PatternError(f"{source}: no foldcore:thickness; not a foldcore result file")
+    _check_reach(positions, fold.pattern, fold.thickness, source)
     recipe = {"elastic": faces_cells(d, len(fold.pattern.faces), source) or None,
               "stretch": edges_poisson(d, fold.pattern.n_edges, source) or None,
               "hinge": fold.hinge}
@@ -446,19 +447,41 @@ def read_result(path, hinge_width=None, subdivisions=None) -> ResultFile:
     return ResultFile(fold.pattern, mesh, positions, fold.thickness, misfit, source)
 
 
+MAX_REACH = 1e3  # × (sheet extent + thickness): farthest a folded vertex may lie from the rest
+
+
+def _check_reach(positions, pattern, thickness: float, source: str) -> None:
+    """Refuse a folded frame with a vertex farther than ``MAX_REACH`` × (the sheet's
+    extent + thickness) from the frame's median: no fold of the sheet puts one
+    there, and such values overflow the rotation fits (a coordinate of 1e308
+    made ``np.linalg.svd`` run without end, issue 18)."""
+    extent = float(np.ptp(pattern.vertices, axis=0).max()) + float(thickness)
+    reach = np.abs(positions - np.median(positions, axis=0)).max(axis=1)
+    far = np.flatnonzero(~(reach <= MAX_REACH * extent))
+    if len(far):
+        v = int(far[0])
+        raise PatternError(f"{source}: folded frame: vertex {v} at {positions[v].tolist()} lies "
+                           f"beyond {MAX_REACH:g} × the sheet's extent ({extent:g} mm) from "
+                           "the others; not a fold of this sheet")
+
+
 def _folded_frame(d: dict, source: str):
     """(N, 3) positions (mm) and faces of the last ``foldedForm`` frame of a FOLD dict."""
     from .io.fold import UNIT_MM
 
     frames = d.get("file_frames")
     frames = [f for f in frames if isinstance(f, dict)] if isinstance(frames, list) else []
+    for i, f in enumerate(frames):
+        if not isinstance(f.get("frame_classes", []), list):
+            raise PatternError(f"{source}: file_frames[{i}].frame_classes must be a list of "
+                               f"strings, got {f['frame_classes']!r}")
     folded = [f for f in frames if "foldedForm" in (f.get("frame_classes") or [])]
     if not folded:
         raise PatternError(f"{source}: no folded frame (file_frames with frame_classes "
                            "'foldedForm'); write one with foldcore simulate -o")
     frame = folded[-1]
     unit = frame.get("frame_unit", d.get("frame_unit", "unit"))
-    if unit not in UNIT_MM:
+    if not isinstance(unit, str) or unit not in UNIT_MM:
         raise PatternError(f"{source}: folded frame: unknown frame_unit {unit!r}")
     try:
         x = np.array(frame.get("vertices_coords"), dtype=float) * UNIT_MM[unit]
