@@ -321,22 +321,24 @@ def fitted_rotation(a, b, c, d, e, f, g, h, i, upper):
     return quaternion_matrix(w, x, y, z)
 
 
-@njit(cache=True)
-def fit_rotated(x, ids, target, out):
-    """Write R·target (rotated to fit x[ids]) into ``out``; return the residual.
-
-    ``target`` (m, 3) must be centred; ``out`` may be ``target`` itself (each
-    row is read before it is written). The residual
-    is Σ‖(x − c) − R·target‖² in mm², the element's unweighted energy.
-    Allocates nothing (except on the rare Jacobi path).
-    """
+@njit(cache=True, inline="always")
+def centroid(x, ids):
+    """Mean of the rows ``x[ids]`` as 3 scalars (mm)."""
     m = len(ids)
     c0 = c1 = c2 = 0.0
     for k in range(m):
         c0 += x[ids[k], 0]
         c1 += x[ids[k], 1]
         c2 += x[ids[k], 2]
-    c0, c1, c2 = c0 / m, c1 / m, c2 / m
+    return c0 / m, c1 / m, c2 / m
+
+
+@njit(cache=True, inline="always")
+def fit_about(x, ids, target, c0, c1, c2):
+    """Rotation (9 scalars, row-major) best fitting ``target`` (m, 3), centred, to
+    ``x[ids]`` about its centroid (c0, c1, c2): :func:`fitted_rotation` of their
+    covariance."""
+    m = len(ids)
     a = b = c = d = e = f = g = h = i = sum_p = sum_t = 0.0
     for k in range(m):
         p0, p1, p2 = x[ids[k], 0] - c0, x[ids[k], 1] - c1, x[ids[k], 2] - c2
@@ -352,8 +354,21 @@ def fit_rotated(x, ids, target, out):
         g += p2 * t0
         h += p2 * t1
         i += p2 * t2
-    a, b, c, d, e, f, g, h, i = fitted_rotation(a, b, c, d, e, f, g, h, i,
-                                                0.5 * (sum_p + sum_t))
+    return fitted_rotation(a, b, c, d, e, f, g, h, i, 0.5 * (sum_p + sum_t))
+
+
+@njit(cache=True)
+def fit_rotated(x, ids, target, out):
+    """Write R·target (rotated to fit x[ids]) into ``out``; return the residual.
+
+    ``target`` (m, 3) must be centred; ``out`` may be ``target`` itself (each
+    row is read before it is written). The residual
+    is Σ‖(x − c) − R·target‖² in mm², the element's unweighted energy.
+    Allocates nothing (except on the rare Jacobi path).
+    """
+    m = len(ids)
+    c0, c1, c2 = centroid(x, ids)
+    a, b, c, d, e, f, g, h, i = fit_about(x, ids, target, c0, c1, c2)
     residual = 0.0
     for k in range(m):
         t0, t1, t2 = target[k, 0], target[k, 1], target[k, 2]

@@ -631,9 +631,8 @@ class RigidBodySolver:
         data = np.zeros(len(self.csc_indices))
         lin.grad = np.zeros(self.n_unknowns)
         missing = rigid_normal.assemble(
-            *lin.strip_args[:9], self.n_loc, self.loc_cols, *lin.strip_args[10:13],
-            residual[:24 * s].reshape(s, 8, 3), self.rounds, self.crease_ptr, self.crease_strips,
-            self.csc_indptr, self.csc_indices, data, lin.grad)
+            *lin.strip_args, self.n_loc, residual[:24 * s].reshape(s, 8, 3), self.rounds,
+            self.crease_ptr, self.crease_strips, self.csc_indptr, self.csc_indices, data, lin.grad)
         if lin.extra is not None:
             lin.grad += lin.extra.T @ residual[24 * s:]
             coo = (lin.extra.T @ lin.extra).tocoo()

@@ -41,7 +41,7 @@ from numba import njit, prange
 
 import elements
 from elements._cache import drop_stale_kernels
-from elements._rotation import fitted_rotation
+from elements._rotation import centroid, fit_about
 
 # these kernels call elements._rotation: recompile them when it changes (elements._cache)
 drop_stale_kernels(Path(__file__).parent, numba.__version__, (Path(elements.__file__).parent,),
@@ -115,8 +115,8 @@ def _rotation_columns(s, k, off_w, off_phi, sqrt_w, targets, d_targets, ecols, e
 
 
 @njit(parallel=True, cache=True)
-def assemble(ids, x, c_p, side, off_panel, alpha, own_off, off_w, off_phi, n_loc, loc_cols,
-             sqrt_w, targets, d_targets, residual, rounds, crease_ptr, crease_strips,
+def assemble(ids, x, c_p, side, off_panel, alpha, own_off, off_w, off_phi, loc_cols,
+             sqrt_w, targets, d_targets, n_loc, residual, rounds, crease_ptr, crease_strips,
              indptr, indices, data, grad):
     """Add every strip's JᵀJ into ``data`` (CSC values, fixed pattern) and Jᵀr into ``grad``.
 
@@ -134,9 +134,10 @@ def assemble(ids, x, c_p, side, off_panel, alpha, own_off, off_w, off_phi, n_loc
     own_off : (S, 8) int, local offset of a hinge-interior vertex's columns (−1: none)
     off_w, off_phi : (S,) int, local offsets of the rotation and angle columns
         (angle −1: actuated strip)
-    n_loc : (S,) int; loc_cols : (S, MAX_LOCAL) int, global column of each local
-        one, increasing
+    loc_cols : (S, MAX_LOCAL) int, global column of each local one, increasing
     sqrt_w : (S,) float, √w; targets, d_targets : (S, 8, 3) mm, R t_k and c·R ∂T_k/∂φ
+        (these first thirteen: ``apply_jacobian``'s and ``apply_transpose``'s too)
+    n_loc : (S,) int, local columns of each strip
     residual : (S, 8, 3) mm^(5/2), the strip rows r
     rounds : (R + 1,) int; crease_ptr : (C + 1,) int, crease_strips : (S,) int, the
         strips of each crease (CSR)
@@ -407,12 +408,7 @@ def strip_rows(ids, x, rot_e, shape, sqrt_w, targets, residual):
     sqrt_w : (S,); targets, residual : (S, 8, 3), written
     """
     for s in prange(ids.shape[0]):
-        c0 = c1 = c2 = 0.0
-        for k in range(8):
-            c0 += x[ids[s, k], 0]
-            c1 += x[ids[s, k], 1]
-            c2 += x[ids[s, k], 2]
-        c0, c1, c2 = c0 / 8.0, c1 / 8.0, c2 / 8.0
+        c0, c1, c2 = centroid(x, ids[s])
         sw = sqrt_w[s]
         for k in range(8):
             t0, t1, t2 = shape[s, k, 0], shape[s, k, 1], shape[s, k, 2]
@@ -429,29 +425,9 @@ def fit_strip_rotations(ids, x, shape, rot_e):
     """Each strip's rotation R maximising tr(Rᵀ Σ_k (x_k − x̄) t_kᵀ) (Procrustes), into
     ``rot_e`` (S, 3, 3); ``shape`` (S, 8, 3) centred, mm."""
     for s in prange(ids.shape[0]):
-        c0 = c1 = c2 = 0.0
-        for k in range(8):
-            c0 += x[ids[s, k], 0]
-            c1 += x[ids[s, k], 1]
-            c2 += x[ids[s, k], 2]
-        c0, c1, c2 = c0 / 8.0, c1 / 8.0, c2 / 8.0
-        a = b = c = d = e = f = g = h = i = sum_p = sum_t = 0.0
-        for k in range(8):
-            p0, p1, p2 = x[ids[s, k], 0] - c0, x[ids[s, k], 1] - c1, x[ids[s, k], 2] - c2
-            t0, t1, t2 = shape[s, k, 0], shape[s, k, 1], shape[s, k, 2]
-            sum_p += p0 * p0 + p1 * p1 + p2 * p2
-            sum_t += t0 * t0 + t1 * t1 + t2 * t2
-            a += p0 * t0
-            b += p0 * t1
-            c += p0 * t2
-            d += p1 * t0
-            e += p1 * t1
-            f += p1 * t2
-            g += p2 * t0
-            h += p2 * t1
-            i += p2 * t2
-        r00, r01, r02, r10, r11, r12, r20, r21, r22 = fitted_rotation(
-            a, b, c, d, e, f, g, h, i, 0.5 * (sum_p + sum_t))
+        c0, c1, c2 = centroid(x, ids[s])
+        r00, r01, r02, r10, r11, r12, r20, r21, r22 = fit_about(x, ids[s], shape[s],
+                                                                 c0, c1, c2)
         rot_e[s, 0, 0], rot_e[s, 0, 1], rot_e[s, 0, 2] = r00, r01, r02
         rot_e[s, 1, 0], rot_e[s, 1, 1], rot_e[s, 1, 2] = r10, r11, r12
         rot_e[s, 2, 0], rot_e[s, 2, 1], rot_e[s, 2, 2] = r20, r21, r22
