@@ -4,6 +4,7 @@ from __future__ import annotations
 import glob
 import os
 import platform
+import statistics
 
 
 def cpu_model() -> str:
@@ -58,3 +59,12 @@ def markdown_table(header: list, rows: list) -> str:
     """A Markdown table (the README's) from a header row and rows of cell strings."""
     lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
     return "\n".join(lines + ["| " + " | ".join(row) + " |" for row in rows])
+
+
+def median_run(rows: list) -> dict:
+    """Copy of the run of median wall time among ``rows`` (dicts with "seconds"), its
+    "seconds" the median and "seconds_runs" every run's."""
+    times = [r["seconds"] for r in rows]
+    row = dict(sorted(rows, key=lambda r: r["seconds"])[len(rows) // 2])
+    row.update(seconds=statistics.median(times), seconds_runs=times)
+    return row

@@ -28,7 +28,6 @@ from __future__ import annotations
 import itertools
 import json
 import os
-import statistics
 import sys
 import time
 from pathlib import Path
@@ -38,7 +37,7 @@ import numpy as np
 from foldcore import kinematics, patterns, thicken
 from foldcore.simulation import Simulation
 
-from _meta import machine_meta, markdown_table
+from _meta import machine_meta, markdown_table, median_run
 from scaling import others_busy
 
 RESULTS = Path(__file__).parent / "results"
@@ -98,13 +97,11 @@ def fold(scene, model: str, strategy: str, actuation: str = "equal", budget: int
 def measured(scene, model, strategy, actuation="equal", runs=RUNS, **kw) -> dict:
     """Median-time run of ``runs`` (its error, iterations, …) and every run's seconds."""
     rows = [fold(scene, model, strategy, actuation, **kw) for _ in range(runs)]
-    times = [r["seconds"] for r in rows]
-    row = rows[int(np.argsort(times)[len(times) // 2])]
+    row = median_run(rows)
     out = {k: v for k, v in row.items() if k != "trace" or kw.get("trace_every")}
-    out.update(model=model, strategy=strategy, actuation=actuation,
-               seconds=statistics.median(times), seconds_runs=times)
+    out.update(model=model, strategy=strategy, actuation=actuation)
     print(f"  {model:5s} {strategy:7s} {actuation:6s} err {row['error_deg']:.3g}° "
-          f"its {row['iterations']:5d} {statistics.median(times):.3f} s", flush=True)
+          f"its {row['iterations']:5d} {row['seconds']:.3f} s", flush=True)
     return out
 
 

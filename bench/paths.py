@@ -20,7 +20,6 @@ prints the README's line.
 from __future__ import annotations
 
 import json
-import statistics
 import sys
 import time
 from pathlib import Path
@@ -75,13 +74,6 @@ def path(predict: bool) -> dict:
             "error_deg": float(np.abs(results[-1].fold_angles_deg[creases] - expected).max())}
 
 
-def median_row(rows: list) -> dict:
-    times = [r["seconds"] for r in rows]
-    row = dict(rows[int(np.argsort(times)[len(times) // 2])])
-    row.update(seconds=statistics.median(times), seconds_runs=times)
-    return row
-
-
 def table(path_json: Path = RESULTS / "paths.json") -> str:
     from _meta import markdown_table
 
@@ -100,7 +92,7 @@ def table(path_json: Path = RESULTS / "paths.json") -> str:
 
 
 def main() -> None:
-    from _meta import machine_meta
+    from _meta import machine_meta, median_run
     from scaling import others_busy
 
     one_fold(), path(True)  # warm-up (numba cache loads, first-call costs)
@@ -114,7 +106,7 @@ def main() -> None:
     data = {"meta": {**machine_meta(), "date": time.strftime("%Y-%m-%d"), "runs": RUNS,
                      "frames": FRAMES, "tolerance": TOLERANCE, "others_busy_before": busy,
                      "others_busy_after": others_busy()},
-            **{k: median_row(v) for k, v in rows.items()}}
+            **{k: median_run(v) for k, v in rows.items()}}
     RESULTS.mkdir(exist_ok=True)
     (RESULTS / "paths.json").write_text(json.dumps(data, indent=1))
     print(table())

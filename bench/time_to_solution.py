@@ -132,16 +132,16 @@ def run_probe(case: str, strategy: str, env=None) -> dict:
 
 def summarise(rows: list) -> list:
     """Median-time row per (case, strategy), with every run's seconds."""
+    from _meta import median_run
+
     out = []
     for case in CASES:
         for strategy in STRATEGIES:
             runs = [r for r in rows if r["case"] == case and r["strategy"] == strategy]
             if not runs:
                 continue
-            times = [r["seconds"] for r in runs]
-            row = dict(runs[int(np.argsort(times)[len(times) // 2])])
-            row.update(seconds=statistics.median(times), seconds_runs=times,
-                       bare_solves=statistics.median(times) / row["bare_solve_s"])
+            row = median_run(runs)
+            row["bare_solves"] = row["seconds"] / row["bare_solve_s"]
             out.append(row)
     return out
 
