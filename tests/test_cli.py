@@ -65,9 +65,27 @@ def test_not_converging_is_a_result_with_a_warning(fold_file, tmp_path, capsys):
     code = main(["simulate", str(fold_file), "--solver", "paper", "--max-iterations", "5",
                  "-o", str(out), "--report", str(report)])
     assert code == 0
-    assert json.loads(report.read_text())["converged"] is False
+    rep = json.loads(report.read_text())
+    assert rep["converged"] is False and rep["reason"] == "budget"
     assert "not converged" in capsys.readouterr().err
     assert out.exists()
+
+
+def test_a_stalled_run_says_so_in_the_report_and_on_stderr(tmp_path, capsys):
+    """Issue 18's reproducer through the CLI: a hinge at thickness / size = 1e-4 under
+    lbfgs stopped "converged" after 2 iterations, 90° short."""
+    pattern = patterns.single_hinge(panel_length=10.0, depth=10.0, angle=TARGET)
+    path, report = tmp_path / "thin.fold", tmp_path / "r.json"
+    write_fold(path, pattern, thickness=0.002)
+    code = main(["simulate", str(path), "--solver", "lbfgs", "--max-iterations", "300",
+                 "--report", str(report)])
+    assert code == 0
+    rep = json.loads(report.read_text())
+    assert rep["fold_angles_deg"][0] < 80.0
+    assert rep["converged"] is False and rep["reason"] == "stalled"
+    assert rep["residual"] is None or rep["residual"] > 1e-8
+    (line,) = capsys.readouterr().err.splitlines()
+    assert str(path) in line and "stalled" in line
 
 
 def _edit(fold_file, tmp_path, change) -> str:

@@ -248,9 +248,9 @@ def simulate(args) -> int:
         sim.set_fold_percent(args.fold_percent)
         result = sim.run(tolerance=args.tolerance, max_iterations=args.max_iterations)
     if not result.converged:
-        print(f"foldcore: warning: not converged after {result.iterations} iterations "
-              f"(tolerance {args.tolerance:g}); the result is the last iterate",
-              file=sys.stderr)
+        print(f"foldcore: warning: {args.pattern}: not converged after {result.iterations} "
+              f"iterations ({_why(result)}; tolerance {args.tolerance:g}); the result is "
+              "the last iterate", file=sys.stderr)
     settings = {k: getattr(args, k) for k in ("pattern", "fold_percent", "solver",
                                               "tolerance", "max_iterations", "subdivisions")}
     settings.update(thickness_mm=thickness, hinge=sorted(set(mesh.hinge_model) - {""}),
@@ -259,6 +259,15 @@ def simulate(args) -> int:
     write_result(result, pattern, mesh, thickness, settings, fold=args.output,
                  report=args.report, png=args.render)
     return 0
+
+
+def _why(result) -> str:
+    """Why a run ended unconverged, in words (Result.reason and residual)."""
+    far = (f", the equilibrium estimated {result.residual:.1e} × the pattern size away"
+           if result.residual == result.residual else "")  # NaN: never estimated
+    return {"stalled": "stalled: steps within the tolerance" + far,
+            "budget": "--max-iterations reached" + far,
+            "callback": "stopped"}.get(result.reason, result.reason)
 
 
 def _animate(args, sim):

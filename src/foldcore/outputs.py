@@ -104,6 +104,8 @@ def report_dict(result, pattern, mesh, settings: dict, quantities: dict | None =
     return {
         "iterations": int(result.iterations),
         "converged": bool(result.converged),
+        "reason": result.reason,
+        "residual": float(result.residual) if np.isfinite(result.residual) else None,
         "energy": float(energy[-1]) if len(energy) else 0.0,
         "energy_history": energy.tolist(),
         "fold_angles_deg": _nullable(result.fold_angles_deg),

@@ -5,6 +5,7 @@ Units at this API: mm for lengths and positions, degrees for angles.
 from __future__ import annotations
 
 import time
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 
 import numba
@@ -20,6 +21,7 @@ from .measure import fold_angles
 from .strategies import DEFAULT_SOLVER
 from .system import System
 from .threads import blas_on_one_thread
+from .verdict import EquilibriumCheck
 
 ALPHA_UPDATE_EVERY = 10  # iterations between α-schedule updates (each costs a refactor)
 STOP_ENTER = 1e-3  # rad past its bound before a passive strip becomes a stop
@@ -58,7 +60,8 @@ class Result:
     strip_angles_deg : (S,) float, bend angle used by each hinge sub-strip
     energy : (iterations,) float, energy before each global step, mm⁵
     iterations : int
-    converged : bool
+    converged : bool, the run ended at an equilibrium of the strategy's model within
+        the tolerance (``reason == "converged"``), not merely with a small step
     timings_s : dict with ``setup``, ``projection`` (element kernels), ``solve`` (the
         rhs gather, the K⁻¹ solve and, for ``paper``, taking its result and
         largest move), ``total`` (setup + every :meth:`Simulation.run` so far)
@@ -74,6 +77,16 @@ class Result:
         model shape: the RMS distance (mm) of its vertices from its rotated
         target at ``positions`` — 0 where the hinge model is met, > 0 where
         the model binds (a vertex that cannot close, conflicting targets)
+    reason : str, why the run ended: ``"converged"``; ``"stalled"`` (steps within the
+        tolerance, or the plain map's rate too slow for the budget, but the
+        equilibrium not reached: :mod:`foldcore.verdict`); ``"budget"``
+        (``max_iterations`` ran out); ``"callback"`` (the callback returned False);
+        ``"none"`` for a snapshot taken outside a run
+    residual : float, the estimated distance to the equilibrium at the end, relative to
+        the pattern size (dimensionless): the probe's estimate for the local/global
+        strategies (:mod:`foldcore.verdict`), the last Levenberg–Marquardt step's
+        length for ``rigid`` (and ``hybrid`` ending in its rigid phase); NaN if
+        never measured in the run
     """
 
     positions: np.ndarray
@@ -87,6 +100,9 @@ class Result:
     failures: list = field(default_factory=list)
     target_angles_deg: np.ndarray | None = None
     hinge_misfit_mm: np.ndarray | None = None
+    reason: str = "none"
+    residual: float = float("nan")
+
 
 
 class _GroupRun:
@@ -262,6 +278,8 @@ class Simulation:
         self.energy_history: list[float] = []
         self.timings = {"setup": time.perf_counter() - start, "projection": 0.0, "solve": 0.0}
         self.length_scale = float(np.ptp(pattern.vertices, axis=0).max())
+        self._scratch = False  # True while a probe projects (no stop changes)
+        self.equilibrium = EquilibriumCheck(self)  # the local/global strategies' verdict
         self._monitor = self._failure_monitor(strain_limits)
         self._bare_solve = None  # (K version, seconds) of the last bare-solve timing
         self.strategy = strategy(self)  # the one thing that moves self.x
@@ -438,13 +456,28 @@ class Simulation:
         t0 = time.perf_counter()
         energy = sum(run.project(x, self._targets, w)
                      for run, w in zip(self._runs, self.system.weights))
-        self._update_stops(x)
+        if not self._scratch:
+            self._update_stops(x)
         t1 = time.perf_counter()
         rhs = self.system.rhs(self._targets, self._rhs)
         energy += self._add_pin_terms(rhs, x)
         self.timings["projection"] += t1 - t0
         self.timings["solve"] += time.perf_counter() - t1
         return energy, rhs
+
+    @contextmanager
+    def scratch_projections(self):
+        """Within: :meth:`local_step` leaves the stops as they are and, on leaving, every
+        group's energies and state are restored (a probe of the map, :mod:`foldcore.verdict`,
+        must not change the model it checks)."""
+        saved = [(run.energy.copy(), run.state.copy()) for run in self._runs]
+        self._scratch = True
+        try:
+            yield
+        finally:
+            self._scratch = False
+            for run, (energy, state) in zip(self._runs, saved):
+                run.energy[:], run.state[:] = energy, state
 
     def global_step(self, rhs: np.ndarray) -> np.ndarray:
         """K⁻¹ rhs, (N, 3) mm, C-contiguous; its time counts as solve time."""
@@ -454,7 +487,10 @@ class Simulation:
         return out
 
     def run(self, tolerance: float = 1e-8, max_iterations: int = 10_000, callback=None) -> Result:
-        """Iterate until the largest step is ≤ ``tolerance`` × pattern size.
+        """Iterate until the strategy settles at an equilibrium within ``tolerance``
+        (steps ≤ ``tolerance`` × pattern size and, for the local/global strategies,
+        the probe of :mod:`foldcore.verdict` finding the equilibrium that close; the
+        rigid-body strategies' own test, :meth:`foldcore.rigid_body.RigidBodySolver.settled`).
 
         From a flat sheet (every crease within ``branch_floor_deg`` of 0°) with
         a crease driven and passive M/V creases, the run has two stages: the
@@ -463,7 +499,8 @@ class Simulation:
         tolerance if looser), then the run itself from there with the floor
         released. Both count in ``max_iterations`` and in ``iterations``
         (``branch_iterations`` counts the first). A run from a folded state is
-        a single stage.
+        a single stage. ``Result.reason`` says why the run ended, ``Result.residual``
+        how far from the equilibrium it was estimated to be.
 
         Parameters
         ----------
@@ -480,28 +517,30 @@ class Simulation:
         self.runs += 1
         self.timings.setdefault("total", self.timings["setup"])
         budget, limit = int(max_iterations), tolerance * self.length_scale
-        settled = stopped = False
+        reason = "budget"
         with blas_on_one_thread(self.threads > 1):
             if self._starts_flat():
-                used, settled, stopped = self._branch_stage(budget, callback, limit)
+                used, reason = self._branch_stage(budget, callback, limit)
                 budget -= used
-                settled = False  # the released stage has yet to settle
-            if budget > 0 and not stopped:
-                _, settled, stopped = self._stage(budget, callback, limit)
+            if budget > 0 and reason != "callback":
+                _, reason = self._stage(budget, callback, limit)
+            elif reason != "callback":
+                reason = "budget"  # the released stage has yet to settle
         self.timings["total"] += time.perf_counter() - start
         self.timings["bare_solve"] = self._bare_solve_floor()
-        return self.result(settled and not stopped)
+        return self.result(reason == "converged", reason)
 
-    def _stage(self, budget: int, callback, limit: float) -> tuple[int, bool, bool]:
+    def _stage(self, budget: int, callback, limit: float) -> tuple[int, str]:
         """One bracketed stretch of strategy steps (:meth:`_iterate`); returns
-        (steps taken, whether the strategy settled, whether the callback stopped)."""
+        (steps taken, why it ended: the ``reason`` of :class:`Result`)."""
         before = self.iterations
+        self.equilibrium.new_run()
         self.strategy.begin_run()
         try:
-            settled, stopped = self._iterate(budget, callback, limit)
+            reason = self._iterate(budget, callback, limit)
         finally:
             self.strategy.end_run()
-        return self.iterations - before, settled, stopped
+        return self.iterations - before, reason
 
     def _starts_flat(self) -> bool:
         """Whether this run needs the branch stage: a floor is set, some passive crease
@@ -517,7 +556,7 @@ class Simulation:
         angles = self.fold_angles()
         return bool(np.nanmax(np.abs(angles), initial=0.0) < self.branch_floor_deg)
 
-    def _branch_stage(self, budget: int, callback, limit: float) -> tuple[int, float, bool]:
+    def _branch_stage(self, budget: int, callback, limit: float) -> tuple[int, str]:
         """Fold from flat with every passive M/V crease held at least
         ``branch_floor_deg`` on its assigned side, to ``BRANCH_TOLERANCE`` (or the
         run's, if looser), then release the floor to the user's (why:
@@ -534,20 +573,24 @@ class Simulation:
         self.branch_iterations += result[0]
         return result
 
-    def _iterate(self, budget: int, callback, limit: float) -> tuple[bool, bool]:
-        """Up to ``budget`` steps, until the strategy is settled (e.g. a step moved ≤
-        ``limit`` mm, :meth:`Strategy.settled`) or the callback says stop; returns
-        (whether the strategy settled, whether the callback stopped). A run whose
-        budget ends is not settled, however small its last step."""
-        for _ in range(budget):
+    def _iterate(self, budget: int, callback, limit: float) -> str:
+        """Up to ``budget`` steps, until the strategy is settled (:meth:`Strategy.settled`:
+        a step within ``limit`` mm at an equilibrium), the callback says stop, or the
+        plain map's rate says the budget cannot reach the equilibrium; returns the
+        ``reason`` of :class:`Result`. A run whose budget ends is not settled,
+        however small its last step (``"stalled"`` if its steps were within the limit
+        but its last check found the equilibrium farther, else ``"budget"``)."""
+        for used in range(1, budget + 1):
             moved = self._step()
             if not np.isfinite(moved):
                 raise SimulationError("the iteration produced non-finite positions")
             if callback is not None and callback(self, moved) is False:
-                return False, True
+                return "callback"
             if self.strategy.settled(moved, limit):
-                return True, False
-        return False, False
+                return "converged"
+            if self.strategy.plain_map and self.equilibrium.hopeless(limit, budget - used):
+                return "stalled"
+        return "stalled" if self.equilibrium.failed else "budget"
 
     def _bare_solve_floor(self) -> float:
         """:meth:`bare_solve_seconds`, timed once per factorisation of K (a sweep of
@@ -600,8 +643,9 @@ class Simulation:
         g = self._hinges.group
         return strip_strains(g.params, estimated_strip_angles(g, self.x))
 
-    def result(self, converged: bool) -> Result:
-        """Snapshot of the current state as a :class:`Result`.
+    def result(self, converged: bool, reason: str | None = None) -> Result:
+        """Snapshot of the current state as a :class:`Result` (``reason`` defaults to
+        ``"converged"`` or ``"none"`` by ``converged``).
 
         With strain limits and a strategy other than ``"paper"``, this is
         where the current state is checked (``run`` ends with it; a loop of
@@ -615,7 +659,9 @@ class Simulation:
                       np.array(self.energy_history), self.iterations, converged, timings,
                       self.strip_strains(),
                       list(self._monitor.failures) if self._monitor is not None else [],
-                      self.target_angles(), self.hinge_misfits())
+                      self.target_angles(), self.hinge_misfits(),
+                      reason or ("converged" if converged else "none"),
+                      float(self.equilibrium.residual))
 
     def target_angles(self) -> np.ndarray:
         """(E,) effective target of every crease in degrees (valley > 0): its fold

@@ -18,8 +18,10 @@ one strategy, which only moves the state. Built in:
 
 The protocol (:class:`Strategy`): ``step()`` advances ``sim.x`` by one
 iteration and returns (energy before, largest move in mm); ``settled(moved,
-limit)`` says whether a run may stop after a step that moved ``moved`` mm
-(a composite may change phase there instead); ``begin_run()`` /
+limit)`` says whether a run may stop after a step that moved ``moved`` mm —
+by default only when the equilibrium probe agrees (:mod:`foldcore.verdict`:
+a small step alone is not a verdict; a composite may change phase there
+instead); ``begin_run()`` /
 ``end_run()`` bracket every :meth:`Simulation.run` (``end_run`` also when
 it is interrupted); ``targets_changed()`` / ``positions_set()`` tell it that
 the model changed under it. A user strategy is a subclass in any module
@@ -60,6 +62,10 @@ class Strategy:
 
     name: str = ""
     abstract: bool = False  # True in a class's own body: a base for others, not registered
+    #: Whether the steps are the paper's plain map, whose rate the equilibrium probe
+    #: measures (:mod:`foldcore.verdict`): then a run that cannot reach the equilibrium
+    #: within its budget at that rate ends at once, ``stalled``.
+    plain_map: bool = False
 
     def __init_subclass__(cls, **kwargs):
         super().__init_subclass__(**kwargs)
@@ -79,8 +85,10 @@ class Strategy:
 
     def settled(self, moved: float, limit: float) -> bool:
         """Whether a run may stop after a step that moved ``moved`` mm (limit: the
-        run's tolerance × pattern size, mm)."""
-        return moved <= limit
+        run's tolerance × pattern size, mm). Default: the step is within the limit
+        and the equilibrium probe finds the state that close to the paper model's
+        equilibrium (:class:`foldcore.verdict.EquilibriumCheck`, ``sim.equilibrium``)."""
+        return self.sim.equilibrium.settled(moved, limit)
 
     def begin_run(self) -> None:
         """A :meth:`Simulation.run` starts."""

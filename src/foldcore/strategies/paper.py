@@ -20,6 +20,7 @@ class PaperMap(Strategy):
     """One local step then one global solve per :meth:`step`."""
 
     name = "paper"
+    plain_map = True
 
     def step(self) -> tuple[float, float]:
         sim = self.sim
