@@ -214,3 +214,70 @@ def test_report_gives_each_actuated_crease_and_where_the_hinge_model_breaks(tmp_
             assert data["hinges"]["largest_overlap_mm"] >= 0.0
     assert misses["100", "angle"] < 0.1 < misses["100", "equal"]
     assert main(["simulate", str(src), "--branch-floor", "-1"]) == 2
+
+
+# ------------------------------------------------ the output contract on failure paths
+def _reversed_faces(fold_file, tmp_path) -> str:
+    """The hinge file with both faces clockwise: each read warns once."""
+    d = json.loads(fold_file.read_text())
+    d["faces_vertices"] = [f[::-1] for f in d["faces_vertices"]]
+    path = tmp_path / "clockwise.fold"
+    path.write_text(json.dumps(d))
+    return str(path)
+
+
+def test_a_bad_output_path_is_refused_before_the_run_and_nothing_is_written(
+        fold_file, tmp_path, capsys):
+    out = tmp_path / "o.fold"
+    code = main(["simulate", str(fold_file), "-o", str(out),
+                 "--report", str(tmp_path / "missing" / "r.json")])
+    assert code == 2
+    (line,) = capsys.readouterr().err.splitlines()
+    assert "--report" in line and str(tmp_path / "missing" / "r.json") in line
+    assert ".tmp" not in line
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["hinge.fold"]
+
+
+def test_an_output_that_is_the_input_is_refused(fold_file, capsys):
+    before = fold_file.read_bytes()
+    assert main(["simulate", str(fold_file), "-o", str(fold_file)]) == 2
+    assert "is the input file" in capsys.readouterr().err
+    assert fold_file.read_bytes() == before
+
+
+def test_warnings_are_one_line_per_kind_and_a_refusal_is_one_line(fold_file, tmp_path,
+                                                                    capsys):
+    path = _reversed_faces(fold_file, tmp_path)
+    assert main(["simulate", path, "--max-iterations", "3"]) == 0
+    lines = capsys.readouterr().err.splitlines()
+    clockwise = [x for x in lines if "was clockwise" in x]
+    assert len(clockwise) == 1 and "(and 1 more like it)" in clockwise[0]
+    assert main(["simulate", path, "--report", str(tmp_path / "no" / "r.json")]) == 2
+    (line,) = capsys.readouterr().err.splitlines()
+    assert line.startswith("foldcore: error:")
+
+
+@pytest.mark.parametrize("how, code", [("SIGINT", 130), ("SIGTERM", 143)])
+def test_a_signal_during_the_writes_leaves_no_file(fold_file, tmp_path, capsys,
+                                                  monkeypatch, how, code):
+    """The report is written after the FOLD file: a signal there must take the
+    finished FOLD's temporary file with it (all or nothing) and end in one line."""
+    import os
+    import signal
+
+    from foldcore import outputs
+
+    def interrupted(*args):
+        if how == "SIGINT":
+            raise KeyboardInterrupt
+        os.kill(os.getpid(), signal.SIGTERM)
+
+    monkeypatch.setattr(outputs, "report_dict", interrupted)
+    out_dir = tmp_path / "out"
+    out_dir.mkdir()
+    assert main(["simulate", str(fold_file),
+                 "-o", str(out_dir / "o.fold"), "--report", str(out_dir / "r.json")]) == code
+    (line,) = capsys.readouterr().err.splitlines()
+    assert how in line
+    assert list(out_dir.iterdir()) == []
+    assert signal.getsignal(signal.SIGTERM) is signal.SIG_DFL  # the handler is put back

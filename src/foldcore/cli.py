@@ -10,14 +10,20 @@ by ``simulate -o`` and rebuild its thick mesh (:func:`foldcore.fabrication.
 read_result`); pass them the ``--hinge-width``/``--subdivisions`` given to
 ``simulate`` when these cannot be recovered from the file.
 
-Exit codes: 0 success (stopping at --max-iterations without convergence is a
-result: exit 0, ``converged: false`` and a warning line on stderr); 2 bad input,
-with one line on stderr naming the problem and no output file written.
+Exit codes: 0 success (a run that ends unconverged — stalled or at
+--max-iterations — is a result: exit 0, ``converged: false`` with its
+``reason`` in the report and a warning line on stderr); 2 bad input, with one
+line on stderr naming the problem and no output file written (every output
+path is checked before the run, :mod:`foldcore.destinations`); 130 / 143
+interrupted by SIGINT / SIGTERM, one line, no half-written file. Warnings are
+one line per kind, with a count of the repeats.
 """
 from __future__ import annotations
 
 import argparse
+import re
 import sys
+import threading
 import warnings
 
 from .hinges import DEFAULT_HINGE, HINGE_MODELS
@@ -25,6 +31,8 @@ from .actuation import ACTUATIONS, BRANCH_FLOOR_DEG, DEFAULT_ACTUATION
 from .strategies import DEFAULT_SOLVER, SOLVERS
 
 EXIT_BAD_INPUT = 2
+EXIT_SIGINT = 130  # 128 + SIGINT, as shells report it
+EXIT_SIGTERM = 143  # 128 + SIGTERM
 
 
 class _Parser(argparse.ArgumentParser):
@@ -223,6 +231,7 @@ def _load(args):
 
 def simulate(args) -> int:
     """Run ``foldcore simulate``; raises FoldcoreError on bad input."""
+    from .destinations import check_destinations
     from .errors import SimulationError
     from .outputs import write_result
     from .simulation import Simulation
@@ -235,6 +244,8 @@ def simulate(args) -> int:
     if thickness is None:
         raise SimulationError(f"{args.pattern}: no thickness: pass --thickness H (mm) "
                               "or set foldcore:thickness in the file")
+    check_destinations({"-o": args.output, "--report": args.report, "--render": args.render,
+                        "--animate": args.animate}, inputs=(args.pattern, args.hinges))
     if args.animate:
         from .animate import check_output
         check_output(args.animate)          # a missing encoder fails before any work
@@ -296,6 +307,9 @@ def render_result(args) -> int:
     from .measure import fold_angles
     from .render import colour_limits, per_strip, render_png, strip_bend_angles
 
+    from .destinations import check_destinations
+
+    check_destinations({"-o": args.output}, inputs=(args.result,))
     res = read_result(args.result, args.hinge_width, args.subdivisions)
     options = {}
     if args.color_by == "strain":   # largest surface tension of each sub-strip
@@ -321,8 +335,12 @@ def export_result(args) -> int:
     """Run ``foldcore export``; raises FoldcoreError on bad input."""
     from .fabrication import ExportError, export, read_result
 
+    from .destinations import check_destinations
+
     if not (args.svg or args.dxf or args.stl):
         raise ExportError(f"{args.result}: nothing to export: give --svg, --dxf and/or --stl")
+    check_destinations({"--svg": args.svg, "--dxf": args.dxf, "--stl": args.stl},
+                       inputs=(args.result,))
     export(read_result(args.result, args.hinge_width, args.subdivisions),
            svg=args.svg, dxf=args.dxf, stl=args.stl)
     return 0
@@ -332,23 +350,71 @@ COMMANDS = {"simulate": simulate, "render": render_result, "export": export_resu
             "scene": run_scene}
 
 
+class Terminated(BaseException):
+    """SIGTERM, raised where the process is, so temporary files are removed on the way
+    out (a BaseException: nothing catches it by accident)."""
+
+
+def _terminate(signum, frame):
+    raise Terminated()
+
+
+def _warning_lines(caught) -> list[str]:
+    """One line per kind of warning, in order of first appearance: the first message
+    and how many more like it (the same text up to its numbers) followed."""
+    first, counts = {}, {}
+    for w in caught:
+        text = " ".join(str(w.message).split())
+        key = (w.category.__name__, re.sub(r"\d+(\.\d+)?", "#", text))
+        first.setdefault(key, text)
+        counts[key] = counts.get(key, 0) + 1
+    return [f"foldcore: warning: {first[k]}" + (f" (and {counts[k] - 1} more like it)"
+                                                 if counts[k] > 1 else "")
+            for k in first]
+
+
 def main(argv=None) -> int:
-    """Entry point of the ``foldcore`` command; returns the exit code."""
+    """Entry point of the ``foldcore`` command; returns the exit code.
+
+    Warnings are printed one line per kind, with a count, after the command
+    succeeds; a refusal prints only its own line. SIGINT and SIGTERM end the
+    command with one line and exit codes 130 and 143; files not yet complete
+    are not written (their temporary files are removed,
+    :mod:`foldcore.destinations`).
+    """
+    import signal
+
     from .errors import FoldcoreError
 
     try:
         args = build_parser().parse_args(argv)
     except SystemExit as exc:  # usage error (already reported) or --help
         return exc.code
+    in_main_thread = threading.current_thread() is threading.main_thread()
+    previous = signal.signal(signal.SIGTERM, _terminate) if in_main_thread else None
     try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("default")
-            return COMMANDS[args.command](args)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            code = COMMANDS[args.command](args)
+        for line in _warning_lines(caught):
+            print(line, file=sys.stderr)
+        return code
     except FoldcoreError as exc:
         print(f"foldcore: error: {exc}", file=sys.stderr)
     except OSError as exc:
         name = exc.filename or getattr(args, "pattern", None) or getattr(args, "result", "")
         print(f"foldcore: error: {name}: {exc.strerror or exc}", file=sys.stderr)
+    except KeyboardInterrupt:
+        print("foldcore: interrupted (SIGINT); files not yet complete were not written",
+              file=sys.stderr)
+        return EXIT_SIGINT
+    except Terminated:
+        print("foldcore: terminated (SIGTERM); files not yet complete were not written",
+              file=sys.stderr)
+        return EXIT_SIGTERM
+    finally:
+        if in_main_thread:
+            signal.signal(signal.SIGTERM, previous)
     return EXIT_BAD_INPUT
 
 

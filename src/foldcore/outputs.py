@@ -175,18 +175,23 @@ def write_result(result, pattern, mesh, thickness: float, settings: dict, *, fol
     thickness : float, mm (stored as ``foldcore:thickness`` in the FOLD file)
     settings : dict, recorded in the report
     fold, report, png : path or None
-        Each file is written atomically; None skips it (and, for ``png``,
-        the pyvista import).
+        None skips it (and, for ``png``, the pyvista import). All or nothing: every
+        file is written to a temporary name first and renamed only when all are
+        written (:func:`foldcore.destinations.all_or_nothing`).
     quantities : dict, optional
         A scene's own measurements, stored in the report.
     """
-    if png:
-        from .render import render_png
-        render_png(pattern, mesh, result.positions, png)
-    if fold:
-        from .io import write_fold
-        write_fold(fold, pattern, achieved_angles=result.fold_angles_deg,
-                   frames=[folded_frame(mesh, result.positions)], thickness=thickness,
-                   extra=_mesh_recipe(pattern, mesh))
-    if report:
-        write_report(report, report_dict(result, pattern, mesh, settings, quantities))
+    from .destinations import all_or_nothing
+
+    with all_or_nothing({"png": png, "fold": fold, "report": report}) as tmp:
+        if png:
+            from .render import render_png
+            render_png(pattern, mesh, result.positions, tmp["png"])
+        if fold:
+            from .io import write_fold
+            write_fold(tmp["fold"], pattern, achieved_angles=result.fold_angles_deg,
+                       frames=[folded_frame(mesh, result.positions)], thickness=thickness,
+                       extra=_mesh_recipe(pattern, mesh))
+        if report:
+            write_report(tmp["report"], report_dict(result, pattern, mesh, settings,
+                                                    quantities))

@@ -550,6 +550,12 @@ def atomic_path(path, suffix: str = ""):
         if not os.path.exists(tmp):
             raise OSError(errno.ENOENT, "the writer produced no file", target)
         os.replace(tmp, target)
+    except OSError as exc:
+        with suppress(OSError):
+            os.unlink(tmp)
+        if exc.filename != tmp:
+            raise
+        raise OSError(exc.errno, exc.strerror, target) from None  # the user's name, not ours
     except BaseException:
         with suppress(OSError):
             os.unlink(tmp)
