@@ -33,7 +33,8 @@ The machine is shared: the share of the cores other processes used is
 recorded before each run (``others_busy``).
 
 Writes bench/results/time_to_solution.json and .png; ``--table`` prints the
-README's table from the JSON.
+README's table from the JSON; ``--rerun lbfgs`` runs only the strategies named
+(comma-separated) again and replaces their rows.
 
 Run: ``.venv/bin/python bench/time_to_solution.py`` (~15 min).
 """
@@ -108,7 +109,7 @@ def probe(case: str, strategy: str) -> dict:
     peak = peak_rss_mb()
     return {"case": case, "strategy": strategy, "seconds": seconds,
             "iterations": int(result.iterations), "converged": bool(result.converged),
-            "error_deg": error, "accurate": bool(error <= ACCURACY_DEG),
+            "reason": result.reason, "error_deg": error, "accurate": bool(error <= ACCURACY_DEG),
             "bare_solve_s": statistics.median(solves), "thick_vertices": int(mesh.n_vertices),
             "peak_rss_mb": peak, "rss_growth_mb": peak - before,
             "kb_per_thick_vertex": (peak - before) * 1024.0 / mesh.n_vertices}
@@ -199,7 +200,7 @@ def table(path: Path = RESULTS / "time_to_solution.json") -> str:
             if r["converged"] and not r["accurate"]:
                 mark += " yet “converged”"
             elif not r["converged"]:
-                mark += ", not converged"
+                mark += f", not converged ({r.get('reason', 'budget')})"
             cells.append(f"{r['seconds']:.3g} s, {r['iterations']} its{mark}")
         r = next(r for r in data["warm"] if r["case"] == case and r["strategy"] == "hybrid")
         cells += [f"{r['thick_vertices']:,}", f"{r['bare_solves']:,.0f}",
@@ -207,6 +208,28 @@ def table(path: Path = RESULTS / "time_to_solution.json") -> str:
         rows.append(cells)
     return markdown_table(["case", *STRATEGIES, "thick vertices", "hybrid / bare solve",
                            "kB / thick vertex (hybrid)"], rows)
+
+
+def rerun(strategies: list) -> None:
+    """Run only ``strategies`` again (same cases and rounds) and replace their rows in
+    the stored JSON; the rerun's date and machine are recorded under ``meta.reruns``
+    (the other strategies' rows keep their own run's)."""
+    from _meta import machine_meta
+
+    path = RESULTS / "time_to_solution.json"
+    data = json.loads(path.read_text())
+    rows = [r for r in data["runs"] if r["strategy"] not in strategies]
+    for case in CASES:
+        print(case, flush=True)
+        for _ in range(1 if case in ONE_RUN else RUNS):
+            for strategy in strategies:
+                rows.append(run_probe(case, strategy))
+    data["meta"].setdefault("reruns", []).append(
+        {**machine_meta(), "date": time.strftime("%Y-%m-%d"), "strategies": strategies})
+    data.update(warm=summarise(rows), runs=rows)
+    path.write_text(json.dumps(data, indent=1))
+    plot(data, RESULTS / "time_to_solution.png")
+    print(table())
 
 
 def main() -> None:
@@ -237,5 +260,8 @@ if __name__ == "__main__":
     elif len(sys.argv) > 1 and sys.argv[1] == "--table":
         sys.path.insert(0, str(HERE))
         print(table())
+    elif len(sys.argv) > 2 and sys.argv[1] == "--rerun":
+        sys.path.insert(0, str(HERE))
+        rerun(sys.argv[2].split(","))
     else:
         main()
