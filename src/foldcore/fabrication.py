@@ -39,6 +39,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from . import limits
 from .errors import FoldcoreError, PatternError
 from .io.fold import atomic_path as io_atomic_path
 from .io.fold import atomic_write
@@ -429,6 +430,8 @@ def read_result(path, hinge_width=None, subdivisions=None) -> ResultFile:
     if fold.thickness is None:
         raise PatternError(f"{source}: no foldcore:thickness; not a foldcore result file")
     _check_reach(positions, fold.pattern, fold.thickness, source)
+    if hinge_width is not None:
+        limits.check_width(hinge_width, fold.pattern.vertices, "--hinge-width", source)
     recipe = {"elastic": faces_cells(d, len(fold.pattern.faces), source) or None,
               "stretch": edges_poisson(d, fold.pattern.n_edges, source) or None,
               "hinge": fold.hinge}

@@ -542,7 +542,8 @@ class Simulation:
         for _ in range(budget):
             moved = self._step()
             if not np.isfinite(moved):
-                raise SimulationError("the iteration produced non-finite positions")
+                raise SimulationError(f"{self.pattern.source}: the iteration produced "
+                                      "non-finite positions")
             if callback is not None and callback(self, moved) is False:
                 return False, True
             if self.strategy.settled(moved, limit):
