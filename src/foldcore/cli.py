@@ -220,13 +220,17 @@ def run_scene(args) -> int:
 def _load(args):
     from .io import read, read_fold_file
     from .errors import PatternError
+    from .limits import check_inputs
 
     if args.pattern.lower().endswith(".fold"):
         if args.hinges:
             raise PatternError(f"{args.pattern}: --hinges only goes with an OBJ/STL pattern")
         fold = read_fold_file(args.pattern)
-        return fold.pattern, fold.thickness, fold.stiffness, fold.hinge
-    return read(args.pattern, hinges=args.hinges), None, None, None
+        loaded = fold.pattern, fold.thickness, fold.stiffness, fold.hinge
+    else:
+        loaded = read(args.pattern, hinges=args.hinges), None, None, None
+    check_inputs(loaded[0], args.thickness, args.hinge_width, loaded[2])
+    return loaded
 
 
 def simulate(args) -> int:

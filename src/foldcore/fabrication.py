@@ -39,6 +39,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from . import limits
 from .errors import FoldcoreError, PatternError
 from .io.fold import atomic_path as io_atomic_path
 from .io.fold import atomic_write
@@ -429,6 +430,8 @@ def read_result(path, hinge_width=None, subdivisions=None) -> ResultFile:
     if fold.thickness is None:
         raise PatternError(f"{source}: no foldcore:thickness; not a foldcore result file")
     _check_reach(positions, fold.pattern, fold.thickness, source)
+    if hinge_width is not None:
+        limits.check_width(hinge_width, fold.pattern.vertices, "--hinge-width", source)
     recipe = {"elastic": faces_cells(d, len(fold.pattern.faces), source) or None,
               "stretch": edges_poisson(d, fold.pattern.n_edges, source) or None,
               "hinge": fold.hinge}
@@ -483,19 +486,46 @@ def _folded_frame(d: dict, source: str):
     unit = frame.get("frame_unit", d.get("frame_unit", "unit"))
     if not isinstance(unit, str) or unit not in UNIT_MM:
         raise PatternError(f"{source}: folded frame: unknown frame_unit {unit!r}")
-    try:
-        x = np.array(frame.get("vertices_coords"), dtype=float) * UNIT_MM[unit]
-        faces = [tuple(int(i) for i in f) for f in frame.get("faces_vertices")]
-    except (TypeError, ValueError):
-        raise PatternError(f"{source}: folded frame: vertices_coords must be [x, y, z] "
-                           "numbers and faces_vertices lists of vertex ids") from None
-    if x.ndim != 2 or x.shape[1] != 3 or not len(x) or not np.isfinite(x).all():
-        raise PatternError(f"{source}: folded frame: vertices_coords must be a list of finite "
-                           f"[x, y, z], got an array of shape {x.shape}")
-    if any(min(f, default=-1) < 0 or max(f, default=len(x)) >= len(x) for f in faces):
-        raise PatternError(f"{source}: folded frame: a face refers to a vertex outside "
-                           f"0..{len(x) - 1}")
-    return x, faces
+    x = _frame_coords(frame.get("vertices_coords"), source) * UNIT_MM[unit]
+    if not np.isfinite(x).all():
+        v = int(np.flatnonzero(~np.isfinite(x).all(axis=1))[0])
+        raise PatternError(f"{source}: folded frame: vertex {v} overflows when converted "
+                           f"to mm (frame_unit {unit!r})")
+    return x, _frame_faces(frame.get("faces_vertices"), len(x), source)
+
+
+def _frame_coords(rows, source: str) -> np.ndarray:
+    """(N, 3) float of a folded frame's ``vertices_coords``: finite JSON numbers only."""
+    from .io.fold import ARRAY, _number, _short
+
+    if not isinstance(rows, ARRAY) or not rows:
+        raise PatternError(f"{source}: folded frame: vertices_coords must be a non-empty "
+                           f"list of [x, y, z], got {_short(rows)}")
+    out = []
+    for i, row in enumerate(rows):
+        xyz = [_number(c) for c in row] if isinstance(row, ARRAY) else []
+        if len(xyz) != 3 or None in xyz:
+            raise PatternError(f"{source}: folded frame: vertices_coords[{i}] must be 3 "
+                               f"finite numbers [x, y, z], got {_short(row)}")
+        out.append(xyz)
+    return np.array(out, dtype=float)
+
+
+def _frame_faces(rows, n: int, source: str) -> list:
+    """A folded frame's ``faces_vertices`` as tuples of vertex ids in 0..n-1."""
+    from .io.fold import ARRAY, _index, _short
+
+    if not isinstance(rows, ARRAY):
+        raise PatternError(f"{source}: folded frame: faces_vertices must be a list of "
+                           f"vertex-id lists, got {_short(rows)}")
+    faces = []
+    for i, row in enumerate(rows):
+        ids = [_index(v, n) for v in row] if isinstance(row, ARRAY) else [None]
+        if None in ids:
+            raise PatternError(f"{source}: folded frame: faces_vertices[{i}] must be vertex "
+                               f"ids in 0..{n - 1}, got {_short(row)}")
+        faces.append(tuple(ids))
+    return faces
 
 
 def _matching_mesh(pattern, thickness, hinge_width, subdivisions, positions, faces, source,

@@ -583,7 +583,8 @@ class Simulation:
         for used in range(1, budget + 1):
             moved = self._step()
             if not np.isfinite(moved):
-                raise SimulationError("the iteration produced non-finite positions")
+                raise SimulationError(f"{self.pattern.source}: the iteration produced "
+                                      "non-finite positions")
             if callback is not None and callback(self, moved) is False:
                 return "callback"
             if self.strategy.settled(moved, limit):

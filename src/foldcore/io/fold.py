@@ -51,6 +51,7 @@ from functools import partial
 
 import numpy as np
 
+from .. import limits
 from ..errors import PatternError
 from ..hinges import HINGE_MODELS
 from ..pattern import DEFAULT_MAX_ANGLE_DEG, CreasePattern
@@ -165,13 +166,14 @@ def fold_file_from_dict(d, source: str = "<fold>") -> FoldFile:
         assignments=_assignments(d, vertices, edges, source),
         fold_angles=_per_edge(d, key, n, source),
         widths=None if widths is None else [
-            None if w is None else _scaled(w, scale, f"{WIDTH_KEY}[{e}] (edge {e})", source)
+            None if w is None else _scaled(w, scale, f"{WIDTH_KEY}[{e}] (edge {e})", source,
+                                           vertices=vertices)
             for e, w in enumerate(widths)],
         max_angles=None if max_angles is None else
         [DEFAULT_MAX_ANGLE_DEG if m is None else m for m in max_angles],
         faces=_faces(d, len(vertices), source), source=source)
     pattern = _build(args)
-    return FoldFile(pattern, _thickness(d, scale, source), unit,
+    return FoldFile(pattern, _thickness(d, scale, source, vertices), unit,
                     _stiffness(d, n, args["faces"], source), _hinge_models(d, n, source))
 
 
@@ -392,22 +394,30 @@ def _positive_factors(values, key: str, item: str, source: str) -> np.ndarray:
     return np.array([1.0 if v is None else float(v) for v in values])
 
 
-def _thickness(d: dict, scale: float, source: str) -> float | None:
+def _thickness(d: dict, scale: float, source: str, vertices) -> float | None:
+    """``foldcore:thickness`` in mm, None if absent; PatternError unless positive and
+    in :mod:`foldcore.limits`' window of the sheet ``vertices`` (mm)."""
     raw = d.get(THICKNESS_KEY)
     if raw is None:
         return None
     value = _number(raw)
     if value is None or not value > 0:
         _fail(source, f"{THICKNESS_KEY} must be a positive number, got {_short(raw)}")
-    return _scaled(value, scale, THICKNESS_KEY, source)
+    mm = _scaled(value, scale, THICKNESS_KEY, source)
+    limits.check_thickness(mm, vertices, THICKNESS_KEY, source)
+    return mm
 
 
-def _scaled(value: float, scale: float, what: str, source: str) -> float:
-    """``value`` × the frame_unit ``scale`` (mm); PatternError if that overflows."""
+def _scaled(value: float, scale: float, what: str, source: str, vertices=None) -> float:
+    """``value`` × the frame_unit ``scale`` (mm); PatternError if that overflows, or,
+    given the sheet's ``vertices`` (mm), if it is not a hinge width of that sheet
+    (:data:`foldcore.limits.WIDTH_RATIO`)."""
     mm = value * scale
     if not np.isfinite(mm):
         _fail(source, f"{what} = {value:g} overflows when converted to mm "
                       f"(× {scale:g}, frame_unit)")
+    if vertices is not None and mm > 0:  # not > 0: the pattern refuses it, naming the edge
+        limits.check_width(mm, vertices, what, source)
     return mm
 
 

@@ -51,6 +51,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .. import limits
 from ..errors import PatternError
 from ..pattern import DEFAULT_MAX_ANGLE_DEG, CreasePattern
 from .fold import _build, _short, atomic_write, read_bytes
@@ -343,6 +344,7 @@ def pattern_from_mesh(vertices, faces, hinges: dict, source: str) -> CreasePatte
     n = len(edges)
     for e in np.flatnonzero(counts > 2):
         raise PatternError(f"{source}: edge {e} is shared by {counts[e]} faces (at most 2)")
+    _check_widths(vertices, hinges, source)
     kinds = np.where(counts == 1, "B", "?")
     angles, widths = np.full(n, np.nan), np.full(n, np.nan)
     max_angles = np.full(n, DEFAULT_MAX_ANGLE_DEG)
@@ -358,6 +360,14 @@ def pattern_from_mesh(vertices, faces, hinges: dict, source: str) -> CreasePatte
                            "the panels are the mesh faces")
     return _build(dict(vertices=vertices, edges=edges, assignments=kinds, fold_angles=angles,
                        widths=widths, max_angles=max_angles, faces=faces, source=source))
+
+
+def _check_widths(vertices, hinges: dict, source: str) -> None:
+    """Each given hinge width within :data:`foldcore.limits.WIDTH_RATIO` of the sheet."""
+    for e, (width, *_, lineno) in hinges.items():
+        if not math.isnan(width):
+            limits.check_width(width, vertices, f"width of edge {e}",
+                                f"{source}, hinge line {lineno}")
 
 
 def _lines(text: str):

@@ -1,0 +1,144 @@
+"""The ranges of the numbers foldcore accepts: the arithmetic survives inside them.
+
+Measured on the hinge scene of ``tests/test_cli.py`` (two 5 mm panels, 2 mm
+deep, one 2 mm hinge at 90°, H = 1 mm, 4 sub-strips, sheet extent 10 mm),
+300 iterations (2000 near the edges), default solver (hybrid) unless said
+(issue 18; ``tests/test_limits.py`` folds the corners of the window):
+
+* thickness / extent: correct from 1e-7 (1001 iterations) to 1e7; at 1e-8
+  it stops at 0° reporting convergence, at 1e8 it lands on −90°, at 1e12 on
+  27°, from 1e99 (paper) or 1e199 (hybrid) non-finite positions; the CLI
+  showed SVD and CHOLMOD tracebacks.
+  Accepted: :data:`THICKNESS_RATIO` = 1e-6 … 1e4, 10× and 1000× inside.
+* hinge width / extent: the axis hinge folds correctly down to 1e-101
+  (the arc hinge to 1e-51; lbfgs needs 1777 iterations at 1e-6 and reports
+  non-convergence below); widths of 1e-300 and 5e-324 mm were tracebacks.
+  Wider than a panel is refused by thicken. Accepted: :data:`WIDTH_RATIO`
+  = 1e-8 … 1e4 (the round-trip tests draw 1e-3 mm hinges on 10³ mm sheets).
+* every length (sheet extent, thickness, widths), mm: the whole scene scaled
+  by 1e-9 … 1e9 folds correctly; by 1e12 it lands on 26°, by 1e-12 it does
+  not converge, by 1e-30 numba kernels raise, by 1e70 positions go
+  non-finite. Accepted: :data:`LENGTH_MM` = 1e-6 … 1e7 mm, 10³× and 100×
+  inside.
+* stiffness factors (one for every hinge, or every panel): hybrid is right
+  from 1e-300 to 1e300; lbfgs reports non-convergence from 1e-20 to 1e-6
+  and 1e12 to 1e300, but claims convergence at 0° for a hinge factor 1e-50
+  and goes non-finite for a panel factor 1e300. Accepted: :data:`STIFFNESS`
+  = 1e-6 … 1e6.
+
+Inside the window the plain local/global map (``--solver paper``) can still
+stop early on a thin sheet or a narrow hinge (it stops on step length alone:
+0° "converged" at H = 1e-6 × extent or W = 1e-6 × extent); that is its
+verdict, not the arithmetic.
+
+Coordinates relative to the sheet need no limit of their own: the scene
+moved 1e8 mm off the origin (1e7 × its extent) folds correctly, and from
+1e9 the crease pattern's own validation refuses it (zero-area faces).
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .errors import PatternError
+
+#: Thickness H accepted, × the sheet's extent.
+THICKNESS_RATIO = (1e-6, 1e4)
+#: Hinge widths W accepted, × the sheet's extent.
+WIDTH_RATIO = (1e-8, 1e4)
+#: Every length accepted (extent, thickness, widths), mm.
+LENGTH_MM = (1e-6, 1e7)
+#: Stiffness factors accepted (dimensionless).
+STIFFNESS = (1e-6, 1e6)
+
+
+def sheet_extent(vertices) -> float:
+    """Largest side of the bounding box of the flat sheet's ``vertices`` (V, 2), mm."""
+    v = np.asarray(vertices, dtype=float).reshape(-1, 2)
+    return float(np.ptp(v, axis=0).max()) if len(v) else 0.0
+
+
+def check_extent(extent: float, where: str) -> None:
+    """PatternError unless the sheet's extent (mm) is within :data:`LENGTH_MM`."""
+    lo, hi = LENGTH_MM
+    if not lo <= extent <= hi:
+        raise PatternError(f"{where}: the sheet is {extent:g} mm across, outside the accepted "
+                           f"{lo:g} … {hi:g} mm (wrong units?)")
+
+
+def length_window(ratio: tuple[float, float], extent: float) -> tuple[float, float]:
+    """The accepted (low, high) mm of a length given as ``ratio`` × ``extent``,
+    clipped to :data:`LENGTH_MM`."""
+    return max(ratio[0] * extent, LENGTH_MM[0]), min(ratio[1] * extent, LENGTH_MM[1])
+
+
+def check_length(value: float, ratio: tuple[float, float], extent: float, what: str,
+                 where: str) -> None:
+    """PatternError naming ``where`` and ``what`` unless ``value`` (mm) is in the window.
+
+    Parameters
+    ----------
+    value : float
+        mm.
+    ratio : (float, float)
+        :data:`THICKNESS_RATIO` or :data:`WIDTH_RATIO`.
+    extent : float
+        The sheet's extent, mm (:func:`sheet_extent`).
+    what, where : str
+        The item (``"foldcore:thickness"``, ``"hinge width"``) and the file or option.
+    """
+    lo, hi = length_window(ratio, extent)
+    if not (math.isfinite(value) and lo <= value <= hi):
+        raise PatternError(f"{where}: {what} = {value:g} mm is outside the accepted "
+                           f"{lo:.3g} … {hi:.3g} mm ({ratio[0]:g} … {ratio[1]:g} × the "
+                           f"sheet's extent {extent:g} mm, within {LENGTH_MM[0]:g} … "
+                           f"{LENGTH_MM[1]:g} mm)")
+
+
+def check_thickness(thickness: float, vertices, what: str, where: str) -> None:
+    """The sheet's extent and the thickness (mm) against :data:`LENGTH_MM` and
+    :data:`THICKNESS_RATIO`; PatternError naming ``where`` and ``what``."""
+    extent = sheet_extent(vertices)
+    check_extent(extent, where)
+    check_length(thickness, THICKNESS_RATIO, extent, what, where)
+
+
+def check_width(width: float, vertices, what: str, where: str) -> None:
+    """A hinge width (mm) against :data:`WIDTH_RATIO` of the sheet ``vertices``.
+
+    Skipped when the sheet's extent is itself out of :data:`LENGTH_MM` (the
+    pattern or :func:`check_extent` refuses that, naming the right item).
+    """
+    extent = sheet_extent(vertices)
+    if LENGTH_MM[0] <= extent <= LENGTH_MM[1]:
+        check_length(float(width), WIDTH_RATIO, extent, what, where)
+
+
+def check_stiffness(stiffness: dict | None, where: str) -> None:
+    """FOLD stiffness factors (``{"hinge": (E,), "panel": (F,)}``) within :data:`STIFFNESS`."""
+    keys = {"hinge": ("foldcore:edges_stiffness", "edge"),
+            "panel": ("foldcore:faces_stiffness", "face")}
+    lo, hi = STIFFNESS
+    for kind, values in (stiffness or {}).items():
+        values = np.atleast_1d(np.asarray(values, dtype=float))
+        bad = np.flatnonzero(~((values >= lo) & (values <= hi)))
+        if len(bad):
+            key, item = keys.get(kind, (kind, "item"))
+            i = int(bad[0])
+            raise PatternError(f"{where}: {key}[{i}] ({item} {i}) = {values[i]:g} is outside "
+                               f"the accepted stiffness factors {lo:g} … {hi:g}")
+
+
+def check_inputs(pattern, thickness=None, hinge_width=None, stiffness=None) -> None:
+    """What ``foldcore simulate`` was given beyond the pattern file's own checks:
+    the sheet's extent, the ``--thickness`` and ``--hinge-width`` options (mm)
+    and the file's stiffness factors; PatternError naming the file and option."""
+    source = pattern.source
+    if thickness is not None or hinge_width is not None:
+        check_extent(sheet_extent(pattern.vertices), source)
+    if thickness is not None:
+        check_thickness(thickness, pattern.vertices, "--thickness", source)
+    if hinge_width is not None:
+        check_width(hinge_width, pattern.vertices, "--hinge-width", source)
+    check_stiffness(stiffness, source)
