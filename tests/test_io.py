@@ -243,6 +243,11 @@ BAD_FOLDS = {  # name: (file text, substrings the message must contain)
     "hinge": (json.dumps(fold_json(two_squares(), **{"foldcore:edges_hinge": [None] * 6
                                                       + ["rigid"]})),
               ["foldcore:edges_hinge[6]", "edge 6", "'axis'"]),
+    # frame 0 must be flat: a vertex below the sheet is refused as firmly as one above
+    "below": (json.dumps(_mutate(fold_json(two_squares()), "vertices_coords", 3, [2, 1, -0.5])),
+              ["vertex 3", "z = -0.5", "flat"]),
+    "above": (json.dumps(_mutate(fold_json(two_squares()), "vertices_coords", 3, [2, 1, 0.5])),
+              ["vertex 3", "z = 0.5", "flat"]),
     "toplevel": ("[1, 2]", ["JSON object"]),
     "missing": ('{"vertices_coords": []}', ["edges_vertices"]),
 }
