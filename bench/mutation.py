@@ -4,7 +4,7 @@ Each mutant replaces one exact snippet of one source file (the snippet must occu
 once) in a *temporary copy* of ``src/`` and ``tests/`` — never the working tree —
 and runs a fast test subset there (``pytest -x``, a timeout per mutant):
 ``killed`` (a test failed), ``survived`` (all passed), ``timeout`` or ``error``
-(pytest could not run: collection failed).
+(the tests did not run: collection failed).
 
 Kernel mutants (``src/elements``, ``rigid_normal.py``) run with
 ``NUMBA_DISABLE_JIT=1``: the kernels run as plain Python (no compile, the same
@@ -14,7 +14,7 @@ unmutated baseline of every subset must pass first.
 
 Writes ``bench/results/mutation.json``. Usage::
 
-    PYTHONPATH=src python bench/mutation.py [--only ID,ID]
+    PYTHONPATH=src python bench/mutation.py [--only ID,ID --out FILE]
 """
 from __future__ import annotations
 
@@ -140,11 +140,12 @@ MUTANTS = [
 
 
 def make_copy(mutant: Mutant | None) -> Path:
-    """Temporary root holding src/ (with its __pycache__), tests/ and pyproject.toml,
-    ``mutant`` applied to the copy."""
+    """Temporary root holding src/ (with its __pycache__), tests/, examples/ (the
+    element tests register its plugin) and pyproject.toml, ``mutant`` applied."""
     root = Path(tempfile.mkdtemp(prefix="foldcore-mutant-"))
     shutil.copytree(ROOT / "src", root / "src")
     shutil.copytree(ROOT / "tests", root / "tests", ignore=shutil.ignore_patterns("__pycache__"))
+    shutil.copytree(ROOT / "examples", root / "examples")
     shutil.copy(ROOT / "pyproject.toml", root)
     if mutant is not None:
         path = root / mutant.file
@@ -174,6 +175,8 @@ def run_subset(root: Path, subset: str) -> dict:
                 "seconds": round(time.perf_counter() - start, 1), "first_failure": None}
     failed = re.search(r"^(?:FAILED|ERROR) (\S+)", proc.stdout, re.MULTILINE)
     outcome = {0: "survived", 1: "killed"}.get(proc.returncode, "error")
+    if "error during collection" in proc.stdout:  # the tests did not run
+        outcome = "error"
     return {"outcome": outcome, "returncode": proc.returncode,
             "seconds": round(time.perf_counter() - start, 1),
             "first_failure": failed.group(1) if failed else None}
@@ -189,7 +192,9 @@ def run_one(mutant: Mutant | None, subset: str) -> dict:
 
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--only", help="comma-separated mutant ids (the JSON is not written)")
+    parser.add_argument("--only", help="comma-separated mutant ids")
+    parser.add_argument("--out", type=Path, default=OUT,
+                        help="JSON written (with --only: only when given)")
     args = parser.parse_args(argv)
     mutants = MUTANTS
     if args.only:
@@ -214,14 +219,14 @@ def main(argv=None) -> int:
     counts = {k: sum(r["outcome"] == k for r in rows)
               for k in ("killed", "survived", "timeout", "error")}
     print(counts, f"{time.perf_counter() - start:.0f} s")
-    if args.only:
+    if args.only and args.out == OUT:
         return 0
     sys.path.insert(0, str(ROOT / "bench"))
     from _meta import machine_meta
 
     commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, text=True,
                             capture_output=True, check=False).stdout.strip()
-    OUT.write_text(json.dumps({
+    args.out.write_text(json.dumps({
         "meta": {**machine_meta(), "date": time.strftime("%Y-%m-%d"), "commit": commit,
                  "load_average_1min": load, "timeout_s": TIMEOUT_S,
                  "total_seconds": round(time.perf_counter() - start, 1),
@@ -229,7 +234,7 @@ def main(argv=None) -> int:
                              for k, v in SUBSETS.items()}},
         "baseline": baseline, "counts": counts, "total": len(rows), "mutants": rows,
     }, indent=1) + "\n")
-    print(f"wrote {OUT}")
+    print(f"wrote {args.out}")
     return 0
 
 
