@@ -270,6 +270,7 @@ SQUARE_OBJ = "v 0 0\nv 1 0\nv 1 1\nv 0 1\nf 1 2 3\nf 1 3 4\n"
 BAD_MESHES = {  # name: (obj text, hinge text, substrings the message must contain)
     "hingeline": (SQUARE_OBJ, "# ok\n\n2 1.0\n", ["bad_hingeline.hinges", "line 3"]),
     "hingewidth": (SQUARE_OBJ, "2 -1 M\n", ["bad_hingewidth.hinges", "line 1", "width"]),
+    "hingezero": (SQUARE_OBJ, "2 0 M\n", ["bad_hingezero.hinges", "line 1", "width"]),
     "hingekind": (SQUARE_OBJ, "2 1 B\n", ["line 1", "'B'"]),
     "hingeid": (SQUARE_OBJ, "\n99 1.0 V 30\n", ["bad_hingeid.hinges", "line 2", "'99'"]),
     "hingesign": (SQUARE_OBJ, "2 1.0 V -30\n", ["line 1", "contradicts"]),
@@ -281,6 +282,7 @@ BAD_MESHES = {  # name: (obj text, hinge text, substrings the message must conta
     "facezero": ("v 0 0\nv 1 0\nv 1 1\nf 0 1 2\n", "", ["bad_facezero.obj", "line 4"]),
     "vertex": ("v 0 zero\n", "", ["bad_vertex.obj", "line 1"]),
     "flat": ("v 0 0 1\n", "", ["bad_flat.obj", "line 1", "z = 1"]),
+    "below": ("v 0 0 -0.5\n", "", ["bad_below.obj", "line 1", "z = -0.5"]),
 }
 
 

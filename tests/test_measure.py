@@ -96,3 +96,22 @@ def test_the_solver_folds_a_valley_hinge_by_lifting_its_free_panel():
     assert result.fold_angles_deg[0] == pytest.approx(90.0, abs=1e-6)
     # converged to 1e-10 on a 5 mm panel held vertical: 1e-6 mm is loose
     assert result.positions[far, 2].mean() == pytest.approx(5.0, abs=1e-6)
+
+
+@pytest.mark.parametrize("sign, excess_deg", [(-1.0, 30.0), (1.0, -90.0)],
+                         ids=["mountain-strip", "valley-strip"])
+def test_a_mountain_strip_past_its_max_angle_has_a_positive_excess(hinge, sign, excess_deg):
+    """The max-angle stop measures a strip on its own side: folded 60° mountain, a
+    mountain strip allowed 30° is 30° past its stop, a valley strip 90° short."""
+    from elements.bending_hinge import MAX_ANGLE, SIGN, TARGET, limit_excess
+
+    pattern, mesh = hinge
+    strips = mesh.groups["bending_hinge"]
+    params = strips.params.copy()
+    params[:, TARGET], params[:, SIGN], params[:, MAX_ANGLE] = np.nan, sign, np.radians(30.0)
+    x = lift(mesh.rest_positions, 1, -60.0)
+    out = np.empty(len(strips))
+    limit_excess(x, strips.indptr, strips.indices, params, out)
+    # one strip spans the whole hinge, its far side turned rigidly: Eq. 9 gives the
+    # turn to rounding
+    assert np.degrees(out) == pytest.approx(np.full(len(strips), excess_deg), abs=1e-9)
