@@ -243,6 +243,11 @@ BAD_FOLDS = {  # name: (file text, substrings the message must contain)
     "hinge": (json.dumps(fold_json(two_squares(), **{"foldcore:edges_hinge": [None] * 6
                                                       + ["rigid"]})),
               ["foldcore:edges_hinge[6]", "edge 6", "'axis'"]),
+    # frame 0 must be flat: a vertex below the sheet is refused as firmly as one above
+    "below": (json.dumps(_mutate(fold_json(two_squares()), "vertices_coords", 3, [2, 1, -0.5])),
+              ["vertex 3", "z = -0.5", "flat"]),
+    "above": (json.dumps(_mutate(fold_json(two_squares()), "vertices_coords", 3, [2, 1, 0.5])),
+              ["vertex 3", "z = 0.5", "flat"]),
     "toplevel": ("[1, 2]", ["JSON object"]),
     "missing": ('{"vertices_coords": []}', ["edges_vertices"]),
 }
@@ -265,6 +270,7 @@ SQUARE_OBJ = "v 0 0\nv 1 0\nv 1 1\nv 0 1\nf 1 2 3\nf 1 3 4\n"
 BAD_MESHES = {  # name: (obj text, hinge text, substrings the message must contain)
     "hingeline": (SQUARE_OBJ, "# ok\n\n2 1.0\n", ["bad_hingeline.hinges", "line 3"]),
     "hingewidth": (SQUARE_OBJ, "2 -1 M\n", ["bad_hingewidth.hinges", "line 1", "width"]),
+    "hingezero": (SQUARE_OBJ, "2 0 M\n", ["bad_hingezero.hinges", "line 1", "width"]),
     "hingekind": (SQUARE_OBJ, "2 1 B\n", ["line 1", "'B'"]),
     "hingeid": (SQUARE_OBJ, "\n99 1.0 V 30\n", ["bad_hingeid.hinges", "line 2", "'99'"]),
     "hingesign": (SQUARE_OBJ, "2 1.0 V -30\n", ["line 1", "contradicts"]),
@@ -276,6 +282,7 @@ BAD_MESHES = {  # name: (obj text, hinge text, substrings the message must conta
     "facezero": ("v 0 0\nv 1 0\nv 1 1\nf 0 1 2\n", "", ["bad_facezero.obj", "line 4"]),
     "vertex": ("v 0 zero\n", "", ["bad_vertex.obj", "line 1"]),
     "flat": ("v 0 0 1\n", "", ["bad_flat.obj", "line 1", "z = 1"]),
+    "below": ("v 0 0 -0.5\n", "", ["bad_below.obj", "line 1", "z = -0.5"]),
 }
 
 

@@ -298,6 +298,21 @@ def test_nonzero_angle_on_flat_edge():
     refused("edge", 6, assignments=a, **with_edge_value("fold_angles", 6, 10.0))
 
 
+@pytest.mark.parametrize("z", [0.5, -0.5], ids=["above", "below"])
+def test_a_vertex_off_the_sheet_is_refused(z):
+    vertices = [(x, y, 0.0) for x, y in SQ_V]
+    vertices[2] = (20.0, 10.0, z)
+    msg = refused("vertex", 2, vertices=vertices)
+    assert f"z = {z:g}" in msg and "flat" in msg, msg
+
+
+@pytest.mark.parametrize("scale", [1e150, -1e150], ids=["positive", "negative"])
+def test_a_coordinate_beyond_the_float64_safe_range_is_refused(scale):
+    """Lengths² and areas of coordinates past 1e100 mm overflow; the sign does not matter."""
+    vertices = [(x * scale / 20.0, y) for x, y in SQ_V]
+    refused("vertex", 1, vertices=vertices, also=["1e\\+100"])
+
+
 @pytest.mark.parametrize("kind, angle", [("V", 190.0), ("M", -200.0), ("U", 181.0)])
 def test_angle_beyond_180(kind, angle):
     a = list(SQ_A)

@@ -16,14 +16,18 @@ first lookup of an unknown name). See ``docs/elements.md``.
 
 Importing the package first drops numba cache files compiled from other
 sources than the current ones (:mod:`elements._cache`: numba keys a kernel on
-its own file only, not on the helpers it calls).
+its own file only, not on the helpers it calls), after making sure numba has a writable cache
+folder (a read-only install without a writable home falls back to another
+folder, or to no cache, with one :class:`foldcore.errors.KernelCacheWarning`).
 """
 from pathlib import Path as _Path
 
 import numba as _numba
 
+from ._cache import choose_cache_dir as _choose_cache_dir
 from ._cache import drop_stale_kernels as _drop_stale_kernels
 
+_choose_cache_dir(_Path(__file__))  # before any cache=True decorator (read-only installs)
 _drop_stale_kernels(_Path(__file__).parent, _numba.__version__)
 
 from ._registry import ElementType, available, get, registered  # noqa: E402

@@ -14,7 +14,8 @@ that ``import foldcore`` is fast and never imports numba kernels or pyvista.
 """
 from importlib import import_module
 
-from .errors import FoldcoreError, MeshError, PatternError, PatternWarning, SimulationError
+from .errors import (FoldcoreError, KernelCacheWarning, MeshError, PatternError, PatternWarning,
+                     SimulationError)
 
 __version__ = "0.1.0"
 
@@ -30,7 +31,7 @@ _LAZY = {
     "kinematics": ("foldcore.kinematics", None),
 }
 
-__all__ = ["FoldcoreError", "MeshError", "PatternError", "PatternWarning",
+__all__ = ["FoldcoreError", "KernelCacheWarning", "MeshError", "PatternError", "PatternWarning",
            "SimulationError", *_LAZY]
 
 

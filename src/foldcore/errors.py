@@ -18,6 +18,12 @@ class PatternWarning(UserWarning):
     (for example a clockwise face reversed to counter-clockwise)."""
 
 
+class KernelCacheWarning(UserWarning):
+    """numba could not cache kernels where it normally does (a read-only install
+    without a writable home); says which folder is used instead, or that kernels
+    compile in every process, and how to choose with ``NUMBA_CACHE_DIR``."""
+
+
 class MeshError(FoldcoreError, ValueError):
     """The thick mesh cannot be built (e.g. hinge widths too large for a face)."""
 

@@ -9,12 +9,17 @@ through a vertex→slot CSR (each vertex sums its own slots: no races).
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import scipy.sparse as sp
 from numba import njit, prange
 
+from elements._cache import choose_cache_dir
+
 from .linsolve import Factor
+
+choose_cache_dir(Path(__file__))  # before this module's cache=True kernels (read-only installs)
 
 TAKE_CHUNKS = 64  # blocks of vertices :func:`take_solution` splits among threads
 
