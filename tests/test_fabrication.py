@@ -279,6 +279,10 @@ def _bad_export_inputs(result_fold, tmp_path):
     edited["file_frames"][0]["vertices_coords"] = edited["file_frames"][0]["vertices_coords"][:-1]
     short = tmp_path / "short.fold"
     short.write_text(json.dumps(edited))
+    data = json.loads(result_fold.read_text())
+    del data["foldcore:thickness"]  # survived bench/mutation.py's run as "no-thickness"
+    no_thickness = tmp_path / "no_thickness.fold"
+    no_thickness.write_text(json.dumps(data))
     variants = {}
     for name, edit in (("huge", lambda f: f["vertices_coords"][3].__setitem__(0, 1e308)),
                        ("classes", lambda f: f.__setitem__("frame_classes", 5)),
@@ -295,6 +299,7 @@ def _bad_export_inputs(result_fold, tmp_path):
         "frame_classes not a list": (["export", str(variants["classes"]), "--stl", stl],
                                      "frame_classes"),
         "frame_unit a list": (["export", str(variants["unit"]), "--stl", stl], "frame_unit"),
+        "no thickness": (["export", str(no_thickness), "--stl", stl], "thickness"),
         "nothing asked": (["export", fold], "nothing to export"),
         "missing file": (["export", str(tmp_path / "nope.fold"), "--stl", stl], "nope.fold"),
         "not a result": (["export", str(plain), "--stl", stl], "no folded frame"),
