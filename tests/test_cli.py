@@ -281,3 +281,14 @@ def test_a_signal_during_the_writes_leaves_no_file(fold_file, tmp_path, capsys,
     assert how in line
     assert list(out_dir.iterdir()) == []
     assert signal.getsignal(signal.SIGTERM) is signal.SIG_DFL  # the handler is put back
+
+
+def test_version_and_a_render_that_is_not_png(fold_file, tmp_path, capsys):
+    """Issue 19's small ones: `--version` exists; `--render out.jpg` wrote PNG bytes
+    under a .jpg name — now refused before the run."""
+    assert main(["--version"]) == 0
+    assert capsys.readouterr().out.strip().startswith("foldcore 0.")
+    assert main(["simulate", str(fold_file), "--render", str(tmp_path / "out.jpg")]) == 2
+    (line,) = capsys.readouterr().err.splitlines()
+    assert "--render" in line and ".png" in line
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["hinge.fold"]

@@ -110,7 +110,10 @@ def _add_rebuild_options(parser) -> None:
 
 
 def build_parser() -> argparse.ArgumentParser:
+    from . import __version__
+
     parser = _Parser(prog="foldcore", description="Thick-origami simulation.")
+    parser.add_argument("--version", action="version", version=f"foldcore {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
     sim = sub.add_parser("simulate", help="fold a crease pattern (FOLD, or OBJ/STL + hinges)")
     sim.add_argument("pattern", help="crease pattern: .fold, or .obj/.stl with a .hinges file")
@@ -249,7 +252,8 @@ def simulate(args) -> int:
         raise SimulationError(f"{args.pattern}: no thickness: pass --thickness H (mm) "
                               "or set foldcore:thickness in the file")
     check_destinations({"-o": args.output, "--report": args.report, "--render": args.render,
-                        "--animate": args.animate}, inputs=(args.pattern, args.hinges))
+                        "--animate": args.animate}, inputs=(args.pattern, args.hinges),
+                       suffixes={"--render": (".png",)})
     if args.animate:
         from .animate import check_output
         check_output(args.animate)          # a missing encoder fails before any work
@@ -313,7 +317,7 @@ def render_result(args) -> int:
 
     from .destinations import check_destinations
 
-    check_destinations({"-o": args.output}, inputs=(args.result,))
+    check_destinations({"-o": args.output}, inputs=(args.result,), suffixes={"-o": (".png",)})
     res = read_result(args.result, args.hinge_width, args.subdivisions)
     options = {}
     if args.color_by == "strain":   # largest surface tension of each sub-strip

@@ -22,7 +22,7 @@ class OutputError(FoldcoreError, ValueError):
     given twice."""
 
 
-def check_destinations(outputs: dict, inputs=()) -> None:
+def check_destinations(outputs: dict, inputs=(), suffixes: dict | None = None) -> None:
     """Refuse output paths that cannot be written, before any work.
 
     Parameters
@@ -31,6 +31,9 @@ def check_destinations(outputs: dict, inputs=()) -> None:
         e.g. ``{"-o": "out.fold", "--report": None}``; None entries are skipped.
     inputs : iterable of paths
         Files the command reads: an output may not overwrite one.
+    suffixes : dict {option name: tuple of suffixes}, optional
+        The file types an option writes (e.g. ``{"--render": (".png",)}``): another
+        suffix is refused rather than written in a format the name does not say.
 
     Raises
     ------
@@ -44,6 +47,10 @@ def check_destinations(outputs: dict, inputs=()) -> None:
         target = os.path.realpath(os.fspath(path))
         folder = os.path.dirname(target)
         where = f"{option} {os.fspath(path)}"
+        allowed = (suffixes or {}).get(option)
+        if allowed and os.path.splitext(target)[1].lower() not in allowed:
+            raise OutputError(f"{where}: writes {' or '.join(allowed)} only; "
+                              f"name the file {os.path.splitext(os.fspath(path))[0]}{allowed[0]}")
         if os.path.isdir(target):
             raise OutputError(f"{where}: is a folder, not a file name")
         if not os.path.isdir(folder):
