@@ -234,7 +234,7 @@ class CreasePattern:
         order = np.argsort(keys)
         u, v = flat, flat[next_in_loop(loop_starts(lengths), lengths)]
         side_key = u * n + v
-        at = np.minimum(np.searchsorted(keys, side_key, sorter=order), len(keys) - 1)
+        at = np.minimum(np.searchsorted(keys[order], side_key), len(keys) - 1)
         slot = order[at]  # e (left) or e + E (right)
         missing = keys[slot] != side_key
         face_of = np.repeat(np.arange(len(lengths)), lengths)

@@ -20,6 +20,9 @@ _SURE = 1e-9
 _TINY = 1e-280
 #: Candidate edge pairs classified per block (memory: ~100 bytes a pair).
 _BLOCK_PAIRS = 4_000_000
+#: Smallest angle (radians) between two edges at a vertex below which the
+#: crossing test checks each pair of edges sharing a vertex for overlap.
+_MIN_GAP_RAD = 1e-6
 
 
 def signed_area(polygon: np.ndarray) -> float:
@@ -247,10 +250,12 @@ def derive_face_loops(vertices: np.ndarray, edges: np.ndarray, boundary: np.ndar
 def crossing_pairs(vertices: np.ndarray, edges: np.ndarray) -> list[tuple[int, int]]:
     """Pairs of edges that cross, overlap, or touch other than at a shared end.
 
-    A shapely STRtree finds the pairs whose bounding boxes meet (near-linear
-    in the number of edges); orientation signs with an error margin settle
-    almost all of them at once, and GEOS decides the few too close to call
-    (exactly as the one-pair-at-a-time test in ``tests/naive.py``).
+    The pairs whose bounding boxes meet come from a uniform grid of cells
+    one edge wide (NumPy; a mesh of similar-sized edges), or from a shapely
+    STRtree when the edge sizes vary too much for it; both are near-linear in
+    the number of edges. Orientation signs with an error margin settle almost
+    all of them at once, and GEOS decides the few too close to call (exactly
+    as the one-pair-at-a-time test in ``tests/naive.py``).
 
     Parameters
     ----------
@@ -262,43 +267,163 @@ def crossing_pairs(vertices: np.ndarray, edges: np.ndarray) -> list[tuple[int, i
     -------
     list of (i, j) with i < j, sorted
     """
+    shared_ok = _spread_at_vertices(vertices, edges)
+    bad = []
+    for left, right in box_pairs(vertices, edges):
+        bad += _bad_pairs(vertices, edges, left, right, shared_ok)
+    return sorted(bad)
+
+
+def box_pairs(vertices: np.ndarray, edges: np.ndarray):
+    """Blocks ``(left, right)`` of all edge pairs ``left < right`` whose (closed)
+    bounding boxes meet, each pair once; see :func:`crossing_pairs`."""
+    p, q = vertices[edges[:, 0]], vertices[edges[:, 1]]
+    lo, hi = np.minimum(p, q), np.maximum(p, q)
+    plan = _grid_plan(lo, hi)
+    if plan is None:
+        yield from _tree_pairs(vertices, edges)
+        return
+    order = plan[0]
+    # boxes in cell order, one contiguous array per side (cheap gathers)
+    x0, y0, x1, y1 = (np.ascontiguousarray(c[order]) for c in (lo[:, 0], lo[:, 1],
+                                                               hi[:, 0], hi[:, 1]))
+    for a, b, same in _grid_blocks(*plan[1:]):
+        meet = np.flatnonzero((x0[a] <= x1[b]) & (x0[b] <= x1[a]) & (a < b if same else True))
+        a, b = a[meet], b[meet]
+        meet = (y0[a] <= y1[b]) & (y0[b] <= y1[a])
+        a, b = order[a[meet]], order[b[meet]]
+        yield np.minimum(a, b), np.maximum(a, b)
+
+
+def _tree_pairs(vertices, edges):
     import shapely
 
     lines = shapely.linestrings(vertices[edges])
     tree = shapely.STRtree(lines)
     block = max(1, _BLOCK_PAIRS // 16)  # ~16 box neighbours per edge on a mesh
-    bad = []
     for s in range(0, len(edges), block):
         left, right = tree.query(lines[s:s + block])
         left += s
         keep = left < right
-        bad += _bad_pairs(vertices, edges, lines, left[keep], right[keep])
-    return sorted(bad)
+        yield left[keep], right[keep]
 
 
-def _bad_pairs(vertices, edges, lines, left, right) -> list[tuple[int, int]]:
-    """Which of the box-overlapping pairs ``left[k] < right[k]`` meet illegally."""
+#: Cell offsets that reach every neighbouring cell once (with the cell itself).
+_HALF_NEIGHBOURS = ((0, 0), (1, -1), (1, 0), (1, 1), (0, 1))
+#: The grid is used while it yields at most this many candidate pairs per edge.
+_GRID_PAIRS_PER_EDGE = 40
+
+
+def _grid_plan(lo: np.ndarray, hi: np.ndarray):
+    """Edges sorted into square cells a little wider than the widest edge box.
+
+    Each edge sits in the cell of its box's lower-left corner; boxes that meet
+    then sit in the same or adjacent cells. Returns (order, cell starts,
+    counts, [(cells, neighbour cells) per offset]), or None when that would
+    give more than :data:`_GRID_PAIRS_PER_EDGE` candidates per edge (edges of
+    very different sizes) or too many cells.
+    """
+    size = 1.01 * float((hi - lo).max())
+    origin = lo.min(axis=0)
+    with np.errstate(all="ignore"):
+        span = (hi.max(axis=0) - origin) / size
+    if not (size > 0 and np.isfinite(span).all() and span.max() < 1e9):
+        return None
+    ij = np.floor((lo - origin) / size).astype(np.int64) + 1
+    rows = int(ij[:, 1].max()) + 2
+    key = ij[:, 0] * rows + ij[:, 1]
+    order = np.argsort(key, kind="stable")
+    cells, starts, counts = np.unique(key[order], return_index=True, return_counts=True)
+    links, total = [], 0
+    for di, dj in _HALF_NEIGHBOURS:
+        target = cells + di * rows + dj
+        at = np.minimum(np.searchsorted(cells, target), len(cells) - 1)
+        found = np.flatnonzero(cells[at] == target)
+        links.append((found, at[found], (di, dj) == (0, 0)))
+        total += int((counts[found] * counts[at[found]]).sum())
+    if total > _GRID_PAIRS_PER_EDGE * len(lo):
+        return None
+    return order, starts, counts, links
+
+
+def _grid_blocks(starts, counts, links):
+    """(a, b, same cell): positions in cell order of every pair of edges in linked
+    cells, in blocks of about :data:`_BLOCK_PAIRS`."""
+    for here, there, same in links:
+        n = counts[here] * counts[there]
+        ends = np.cumsum(n)
+        cuts = np.searchsorted(ends, np.arange(_BLOCK_PAIRS, int(ends[-1]) if len(n) else 0,
+                                               _BLOCK_PAIRS))
+        for h, t, k in zip(np.split(here, cuts), np.split(there, cuts), np.split(n, cuts)):
+            pair = np.repeat(np.arange(len(k)), k)
+            rank = np.arange(int(k.sum())) - np.repeat(np.cumsum(k) - k, k)
+            width = counts[t][pair]
+            yield starts[h][pair] + rank // width, starts[t][pair] + rank % width, same
+
+
+def _spread_at_vertices(vertices: np.ndarray, edges: np.ndarray) -> bool:
+    """True if at every vertex any two edges leave at least :data:`_MIN_GAP_RAD` apart.
+
+    Two edges that share a vertex overlap only if they leave it in exactly
+    the same direction, so then no such pair can overlap (checked in O(E log E)
+    instead of pair by pair).
+    """
+    n_edges = len(edges)
+    origin = np.concatenate([edges[:, 0], edges[:, 1]])
+    d = vertices[np.concatenate([edges[:, 1], edges[:, 0]])] - vertices[origin]
+    with np.errstate(all="ignore"):
+        angle = np.arctan2(d[:, 1], d[:, 0])
+    if not np.isfinite(angle).all():
+        return False
+    order = np.lexsort((angle, origin))
+    origin, angle = origin[order], angle[order]
+    gap = np.diff(angle)
+    same = origin[1:] == origin[:-1]
+    if (gap[same] < _MIN_GAP_RAD).any():
+        return False
+    # around each vertex of degree ≥ 2: from its last edge back to its first
+    first = np.flatnonzero(np.concatenate([[True], ~same]))
+    last = np.concatenate([first[1:], [2 * n_edges]]) - 1
+    many = last > first
+    wrap = angle[first[many]] + 2 * np.pi - angle[last[many]]
+    return not (wrap < _MIN_GAP_RAD).any()
+
+
+def _bad_pairs(vertices, edges, left, right, shared_ok: bool) -> list[tuple[int, int]]:
+    """Which of the box-overlapping pairs ``left[k] < right[k]`` meet illegally
+    (``shared_ok``: no pair sharing a vertex can overlap, :func:`_spread_at_vertices`)."""
     import shapely
 
-    a, b = edges[left], edges[right]
-    same_start = a[:, 0] == b[:, 0]
-    shared = same_start | (a[:, 0] == b[:, 1]) | (a[:, 1] == b[:, 0]) | (a[:, 1] == b[:, 1])
+    u, v = edges[:, 0], edges[:, 1]
+    ul, vl, ur, vr = u[left], v[left], u[right], v[right]
+    shared = (ul == ur) | (ul == vr) | (vl == ur) | (vl == vr)
     apart = np.flatnonzero(~shared)
-    sure_bad, unsure = _classify_apart(vertices, a[apart], b[apart])
+    a = np.stack([ul[apart], vl[apart]], axis=1)
+    b = np.stack([ur[apart], vr[apart]], axis=1)
+    sure_bad, unsure = _classify_apart(vertices, a, b)
     bad = [apart[sure_bad]]
-    hit = shapely.intersects(lines[left[apart[unsure]]], lines[right[apart[unsure]]])
+    def lines(ids):  # geometries only for the few pairs GEOS decides
+        return shapely.linestrings(vertices[edges[ids]])
+
+    hit = shapely.intersects(lines(left[apart[unsure]]), lines(right[apart[unsure]]))
     bad.append(apart[unsure][hit])
     # sharing an end: only that end point may be common (GEOS decides the
     # nearly collinear, same-direction pairs, the only ones that can overlap)
+    if shared_ok:
+        return _pair_list(left, right, bad)
     shared = np.flatnonzero(shared)
-    a, b = a[shared], b[shared]
+    a, b = edges[left[shared]], edges[right[shared]]
     # the two edges leave the common vertex in the same sense iff both start or
     # both end there
     flip = (a[:, 0] == b[:, 0]) | (a[:, 1] == b[:, 1])
     maybe = shared[_maybe_overlapping(vertices, a, b, flip)]
-    inter = shapely.intersection(lines[left[maybe]], lines[right[maybe]])
+    inter = shapely.intersection(lines(left[maybe]), lines(right[maybe]))
     bad.append(maybe[shapely.get_type_id(inter) != 0])
-    k = np.concatenate(bad)
+    return _pair_list(left, right, bad)
+
+
+def _pair_list(left, right, picks: list) -> list[tuple[int, int]]:
+    k = np.concatenate(picks)
     return list(zip(left[k].tolist(), right[k].tolist()))
 
 
@@ -316,16 +441,26 @@ def _sign(det: np.ndarray, margin: np.ndarray) -> np.ndarray:
 
 
 def _classify_apart(vertices, a, b) -> tuple[np.ndarray, np.ndarray]:
-    """Pairs of edges with no common vertex: (surely crossing, too close to call)."""
-    p, q, r, s = (vertices[a[:, 0]], vertices[a[:, 1]], vertices[b[:, 0]],
-                  vertices[b[:, 1]])
+    """Pairs of edges with no common vertex: (surely crossing, too close to call).
+
+    Surely apart: both ends of one edge surely on the same side of the
+    other's line (tested for ``b`` against ``a`` first, which settles most).
+    """
+    p, q = vertices[a[:, 0]], vertices[a[:, 1]]
+    r, s = vertices[b[:, 0]], vertices[b[:, 1]]
     with np.errstate(all="ignore"):
-        o1, o2, o3, o4 = (_sign(*_orient(p, q, r)), _sign(*_orient(p, q, s)),
-                          _sign(*_orient(r, s, p)), _sign(*_orient(r, s, q)))
-    certain = (o1 != 0) & (o2 != 0) & (o3 != 0) & (o4 != 0)
-    apart = ((o1 == o2) & (o1 != 0)) | ((o3 == o4) & (o3 != 0))
-    crossing = certain & (o1 != o2) & (o3 != o4)
-    return crossing, ~apart & ~crossing
+        o1, o2 = _sign(*_orient(p, q, r)), _sign(*_orient(p, q, s))
+        rest = np.flatnonzero(~((o1 == o2) & (o1 != 0)))
+        p, q, r, s = p[rest], q[rest], r[rest], s[rest]
+        o1, o2 = o1[rest], o2[rest]
+        o3, o4 = _sign(*_orient(r, s, p)), _sign(*_orient(r, s, q))
+    apart = (o3 == o4) & (o3 != 0)
+    crossing = (o1 * o2 < 0) & (o3 * o4 < 0)
+    sure_bad = np.zeros(len(a), dtype=bool)
+    unsure = np.zeros(len(a), dtype=bool)
+    sure_bad[rest[crossing]] = True
+    unsure[rest[~apart & ~crossing]] = True
+    return sure_bad, unsure
 
 
 def _maybe_overlapping(vertices, a, b, same_sense) -> np.ndarray:
