@@ -45,7 +45,8 @@ def loop_starts(lengths: np.ndarray) -> np.ndarray:
 
 
 def next_in_loop(starts: np.ndarray, lengths: np.ndarray) -> np.ndarray:
-    """(N,) int64: index of the following corner of each corner's loop (wrapping)."""
+    """(N,) int64: index of the following corner of each corner's loop (wrapping);
+    every loop has at least one corner."""
     nxt = np.arange(1, int(lengths.sum()) + 1, dtype=np.int64)
     nxt[starts + lengths - 1] = starts
     return nxt

@@ -53,6 +53,7 @@ import numpy as np
 
 from ..errors import PatternError
 from ..pattern import DEFAULT_MAX_ANGLE_DEG, CreasePattern
+from ..planar import loop_starts, next_in_loop
 from .fold import _build, _short, atomic_write, read_bytes
 
 HINGE_SUFFIX = ".hinges"
@@ -77,19 +78,23 @@ def mesh_edges(faces) -> np.ndarray:
 
 
 def _edge_table(faces) -> tuple[np.ndarray, np.ndarray]:
-    """(E, 2) edges in hinge-file order and (E,) number of faces on each."""
-    index: dict[tuple[int, int], int] = {}
-    edges, counts = [], []
-    for face in faces:
-        face = [int(v) for v in face]
-        for a, b in zip(face, face[1:] + face[:1]):
-            key = (min(a, b), max(a, b))
-            if key not in index:
-                index[key] = len(edges)
-                edges.append((a, b))
-                counts.append(0)
-            counts[index[key]] += 1
-    return np.array(edges, dtype=np.int64).reshape(-1, 2), np.array(counts, dtype=np.int64)
+    """(E, 2) edges in hinge-file order and (E,) number of faces on each.
+
+    At once: the sides of all faces in file order, each keyed by its sorted
+    vertex pair; an edge is a key's first side, edges ordered by that side.
+    """
+    faces = [f for f in faces if len(f)]  # an empty face has no sides
+    lengths = np.fromiter(map(len, faces), dtype=np.int64, count=len(faces))
+    if not faces:
+        return np.zeros((0, 2), dtype=np.int64), np.zeros(0, dtype=np.int64)
+    flat = np.concatenate([np.asarray(f, dtype=np.int64).ravel() for f in faces])
+    a, b = flat, flat[next_in_loop(loop_starts(lengths), lengths)]
+    lo, hi = np.minimum(a, b), np.maximum(a, b)
+    key = (lo - lo.min()) * (int(hi.max()) - int(lo.min()) + 1) + (hi - lo.min())
+    _, first, inverse, counts = np.unique(key, return_index=True, return_inverse=True,
+                                          return_counts=True)
+    order = np.argsort(first)
+    return np.stack([a[first[order]], b[first[order]]], axis=1), counts[order]
 
 
 # ------------------------------------------------------------------- reading
