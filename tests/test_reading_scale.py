@@ -197,3 +197,39 @@ def test_huge_number_still_refused_by_the_hook():
     digits = json.dumps(d).replace("[1.0, 0.0]", "[" + "9" * 400 + ".0, 0.0]", 1)
     with pytest.raises(PatternError, match="out of range of a 64-bit float"):
         parse_fold(digits.encode(), "g")
+
+
+def old_merge(tris, source):
+    """The STL reader's vertex merge facet by facet (as for ASCII STL)."""
+    from foldcore.io.obj import _merge_vertices
+
+    return _merge_vertices([(f"{source}, facet {i}", t.tolist()) for i, t in enumerate(tris)])
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_binary_stl_merge_at_once_equals_facet_by_facet(seed):
+    from foldcore.io.obj import _merge_triangles
+
+    rng = np.random.default_rng(seed)
+    tris = np.zeros((200, 3, 3))
+    tris[:, :, :2] = rng.integers(-2, 3, size=(200, 3, 2)) * 0.5
+    xy = tris[:, :, :2]  # a view
+    xy[rng.random((200, 3, 2)) < 0.2 * (seed % 2 + 1)] *= -1.0  # -0.0 beside 0.0
+    if seed >= 2:  # one bad vertex (a NaN or a z), maybe after others
+        f, k = rng.integers(0, 200), rng.integers(0, 3)
+        tris[f, k, 2 if seed == 2 else 0] = 1.0 if seed == 2 else np.nan
+        tris[min(f + 7, 199), 0, 2] = 2.0
+    outcomes = []
+    for merge in (old_merge, _merge_triangles):
+        try:
+            outcomes.append(merge(tris, "m.stl"))
+        except PatternError as exc:
+            outcomes.append(str(exc))
+    old, new = outcomes
+    if isinstance(old, str):
+        assert new == old
+    else:
+        np.testing.assert_array_equal(new[0], old[0])
+        assert np.array_equal(np.signbit(new[0]), np.signbit(old[0]))
+        assert len(new[1]) == len(old[1]) and all(
+            np.array_equal(a, b) for a, b in zip(new[1], old[1]))
