@@ -2,11 +2,12 @@
 
 All coordinates are 2D (mm). Faces are returned counter-clockwise (seen from +z).
 
-The functions are vectorised (NumPy, a shapely STRtree for crossings): a
-10⁶-vertex pattern is read in seconds. Where a floating-point sign is too close
-to call (a near-degenerate face, nearly collinear or touching edges) they ask
-the exact answer of the same per-item code as before (``signed_area``, GEOS),
-so the results are those of the one-by-one versions (``tests/naive.py``).
+The functions are vectorised (NumPy and SciPy; crossings from a cell grid or
+a shapely STRtree), so a 10⁶-vertex pattern is checked in seconds. Where a
+floating-point sign is too close to call (a near-degenerate face, nearly
+collinear or touching edges) they ask the same per-item code as before
+(``signed_area``, GEOS), so the results are those of the one-by-one versions
+kept in ``tests/naive.py``.
 """
 from __future__ import annotations
 
