@@ -222,3 +222,68 @@ def project_group(etype_name, x, group_like, params=None):
                                         *extra[e])
         state.append(st)
     return out, energy, np.array(state, dtype=float).reshape(len(energy), -1)
+
+
+# ------------------------------------------------- planar graphs (planar.py's twins)
+# The one-item-at-a-time versions foldcore.planar used before it was vectorised.
+def trace_faces(vertices, edges):
+    """Face cycles by walking each directed edge once (the face on its left)."""
+    nbrs = [[] for _ in range(len(vertices))]
+    for u, v in edges:
+        nbrs[u].append(v)
+        nbrs[v].append(u)
+    rings = []
+    for u, nb in enumerate(nbrs):
+        nb = np.asarray(nb, dtype=np.int64)
+        d = vertices[nb] - vertices[u]
+        rings.append(nb[np.argsort(np.arctan2(d[:, 1], d[:, 0]), kind="stable")])
+    position = [{int(w): i for i, w in enumerate(nb)} for nb in rings]
+    seen, cycles = set(), []
+    for a, b in np.concatenate([edges, edges[:, ::-1]]):
+        start = (int(a), int(b))
+        if start in seen:
+            continue
+        cycle, (u, v) = [], start
+        while (u, v) not in seen:
+            seen.add((u, v))
+            cycle.append(u)
+            around = rings[v]
+            w = int(around[(position[v][u] - 1) % len(around)])
+            u, v = v, w
+        cycles.append(np.asarray(cycle, dtype=np.int64))
+    return cycles
+
+
+def derive_faces(vertices, edges, boundary):
+    """Positive cycles that are not holes (all-boundary, no side on the outer face);
+    None when more than one cycle is negative (not connected)."""
+    from foldcore.planar import signed_area
+
+    cycles = trace_faces(vertices, edges)
+    areas = [signed_area(vertices[c]) for c in cycles]
+    if sum(a < 0 for a in areas) > 1:
+        return None
+    key = {(int(u), int(v)): i for i, (u, v) in enumerate(edges)}
+    key.update({(int(v), int(u)): i for i, (u, v) in enumerate(edges)})
+    sides = lambda c: [key[(int(u), int(v))] for u, v in zip(c, np.roll(c, -1))]
+    outer = {i for c, a in zip(cycles, areas) if a < 0 for i in sides(c)}
+    return [c for c, a in zip(cycles, areas) if a > 0 and not (
+        all(boundary[i] for i in sides(c)) and not any(i in outer for i in sides(c)))]
+
+
+def crossing_pairs(vertices, edges):
+    """Every pair of edges tested with GEOS: (i, j), i < j, that meet other than at a
+    shared end (brute force, O(E²))."""
+    import shapely
+
+    lines = shapely.linestrings(vertices[edges])
+    bad = []
+    for i in range(len(edges)):
+        for j in range(i + 1, len(edges)):
+            if not shapely.intersects(lines[i], lines[j]):
+                continue
+            if set(edges[i].tolist()) & set(edges[j].tolist()) and \
+                    shapely.get_type_id(shapely.intersection(lines[i], lines[j])) == 0:
+                continue
+            bad.append((i, j))
+    return bad

@@ -5,11 +5,20 @@ Units: coordinates, widths in mm; angles in degrees, valley positive (FOLD).
 from __future__ import annotations
 
 import warnings
+from itertools import chain
 
 import numpy as np
 
 from .errors import PatternError, PatternWarning
-from .planar import crossing_pairs, derive_faces, signed_area
+from .planar import (
+    crossing_pairs,
+    derive_face_loops,
+    loop_starts,
+    next_in_loop,
+    signed_area,
+    signed_areas,
+    split_loops,
+)
 
 #: Assignments foldcore simulates. ``C`` (cut) and ``J`` (join) are refused.
 ASSIGNMENTS = ("M", "V", "B", "F", "U")
@@ -69,11 +78,11 @@ class CreasePattern:
         self._validate_edge_values()
         boundary = self.assignments == "B"
         if faces is None:
-            faces = derive_faces(self.vertices, self.edges, boundary, source)
+            flat, lengths = derive_face_loops(self.vertices, self.edges, boundary, source)
         else:
-            faces = self._counter_clockwise(faces)
-        self.faces = tuple(_frozen(f) for f in faces)
-        self.edge_faces = _frozen(self._match_faces())
+            flat, lengths = self._counter_clockwise(*_face_loops(faces))
+        self.faces = tuple(split_loops(_frozen(flat), lengths))
+        self.edge_faces = _frozen(self._match_faces(flat, lengths))
 
     # ----------------------------------------------------------------- queries
     @property
@@ -126,10 +135,11 @@ class CreasePattern:
         scale = float(np.ptp(self.vertices, axis=0).max()) if self.n_vertices else 0.0
         for i in np.flatnonzero(lengths <= 1e-12 * max(scale, 1e-300)):
             self._fail(f"edge {i} {tuple(self.edges[i].tolist())} has zero length")
-        pairs = np.sort(self.edges, axis=1)
-        _, first, counts = np.unique(pairs, axis=0, return_index=True, return_counts=True)
+        # the smallest repeated (min, max) vertex pair: its first and second edge
+        key = self.edges.min(axis=1) * self.n_vertices + self.edges.max(axis=1)
+        _, first, counts = np.unique(key, return_index=True, return_counts=True)
         for i in first[counts > 1]:
-            j = np.flatnonzero((pairs == pairs[i]).all(axis=1))[1]
+            j = np.flatnonzero(key == key[i])[1]
             self._fail(f"edge {j} duplicates edge {i} (vertices {tuple(self.edges[i].tolist())})")
         degree = np.bincount(self.edges.ravel(), minlength=self.n_vertices)
         for v in np.flatnonzero(degree == 0):
@@ -157,17 +167,13 @@ class CreasePattern:
                        "on its own")
 
     def _validate_edge_values(self):
-        for e, (kind, angle) in enumerate(zip(self.assignments, self.fold_angles)):
-            if np.isnan(angle):
-                continue
-            if abs(angle) > 180.0:
-                self._fail(f"edge {e}: fold angle {angle:g}° is outside [-180, 180]")
-            if kind == "M" and angle > 0 or kind == "V" and angle < 0:
-                self._fail(f"edge {e}: fold angle {angle:g}° contradicts assignment "
-                           f"{str(kind)!r} (valley > 0, mountain < 0)")
-            if kind in "BF" and angle != 0:
-                self._fail(f"edge {e}: fold angle {angle:g}° on a {str(kind)!r} edge "
-                           "(must be 0 or passive)")
+        kind, angle = self.assignments, self.fold_angles
+        with np.errstate(invalid="ignore"):
+            bad = ~np.isnan(angle) & ((np.abs(angle) > 180.0) | (kind == "M") & (angle > 0)
+                                      | (kind == "V") & (angle < 0)
+                                      | ((kind == "B") | (kind == "F")) & (angle != 0))
+        for e in np.flatnonzero(bad)[:1]:  # the first edge in error, its first error
+            self._check_angle(e, kind[e], angle[e])
         bad_w = ~np.isnan(self.widths) & ~(self.widths > 0)
         for e in np.flatnonzero(bad_w):
             self._fail(f"edge {e}: hinge width {self.widths[e]:g} mm must be > 0")
@@ -178,38 +184,75 @@ class CreasePattern:
             self._fail(f"edge {e}: fold angle {self.fold_angles[e]:g}° exceeds its "
                        f"max angle {self.max_angles[e]:g}°")
 
-    def _counter_clockwise(self, faces) -> list[np.ndarray]:
-        out = []
-        for i, face in enumerate(faces):
-            face = np.asarray(face, dtype=np.int64).ravel()
-            if len(face) < 3:
-                self._fail(f"face {i} has {len(face)} vertices (needs at least 3)")
-            if face.min() < 0 or face.max() >= self.n_vertices:
-                self._fail(f"face {i} refers to a vertex out of range 0..{self.n_vertices - 1}")
-            area = signed_area(self.vertices[face])
-            if abs(area) <= 0:
-                self._fail(f"face {i} has zero area")
-            if area < 0:
-                warnings.warn(f"{self.source}: face {i} was clockwise; reversed to "
-                              "counter-clockwise", PatternWarning, stacklevel=4)
-                face = face[::-1].copy()
-            out.append(face)
-        return out
+    def _check_angle(self, e: int, kind: str, angle: float):
+        """Refuse edge ``e``'s target ``angle`` (degrees) if it is out of range or
+        contradicts its assignment ``kind``."""
+        if not np.isnan(angle):
+            if abs(angle) > 180.0:
+                self._fail(f"edge {e}: fold angle {angle:g}° is outside [-180, 180]")
+            if kind == "M" and angle > 0 or kind == "V" and angle < 0:
+                self._fail(f"edge {e}: fold angle {angle:g}° contradicts assignment "
+                           f"{str(kind)!r} (valley > 0, mountain < 0)")
+            if kind in "BF" and angle != 0:
+                self._fail(f"edge {e}: fold angle {angle:g}° on a {str(kind)!r} edge "
+                           "(must be 0 or passive)")
 
-    def _match_faces(self) -> np.ndarray:
-        """(E, 2) int: face on the left / right of each edge (u→v), −1 if none."""
-        key = {(int(u), int(v)): (e, 0) for e, (u, v) in enumerate(self.edges)}
-        key.update({(int(v), int(u)): (e, 1) for e, (u, v) in enumerate(self.edges)})
-        edge_faces = np.full((self.n_edges, 2), -1, dtype=np.int64)
-        for f, face in enumerate(self.faces):
-            for u, v in zip(face, np.roll(face, -1)):
-                if (int(u), int(v)) not in key:
-                    self._fail(f"face {f}: its side {int(u)}→{int(v)} is not an edge")
-                e, side = key[(int(u), int(v))]
-                if edge_faces[e, side] >= 0:
-                    self._fail(f"edge {e} has faces {edge_faces[e, side]} and {f} on the "
-                               "same side (overlapping faces)")
-                edge_faces[e, side] = f
+    def _counter_clockwise(self, flat: np.ndarray, lengths: np.ndarray):
+        """Check the face loops (``flat`` ids, ``lengths`` per face); reverse clockwise
+        ones (a warning each). Faces are checked in order; the first bad one is named."""
+        starts = loop_starts(lengths)
+        out_of_range = (flat < 0) | (flat >= self.n_vertices)
+        broken = (lengths < 3) | (np.bincount(np.repeat(np.arange(len(lengths)), lengths),
+                                              weights=out_of_range, minlength=len(lengths)) > 0)
+        n_ok = int(np.argmax(broken)) if broken.any() else len(lengths)
+        areas = signed_areas(self.vertices, flat[:int(starts[n_ok]) if n_ok < len(lengths)
+                                               else len(flat)], lengths[:n_ok])
+        zero = np.flatnonzero(np.abs(areas) <= 0)  # (as before: a NaN area is not zero)
+        n_ok = int(zero[0]) if len(zero) else n_ok
+        for i in np.flatnonzero(areas[:n_ok] < 0):
+            warnings.warn(f"{self.source}: face {i} was clockwise; reversed to "
+                          "counter-clockwise", PatternWarning, stacklevel=4)
+        if n_ok < len(lengths):
+            face = flat[starts[n_ok]:starts[n_ok] + lengths[n_ok]]
+            if len(face) < 3:
+                self._fail(f"face {n_ok} has {len(face)} vertices (needs at least 3)")
+            if face.min() < 0 or face.max() >= self.n_vertices:
+                self._fail(f"face {n_ok} refers to a vertex out of range "
+                           f"0..{self.n_vertices - 1}")
+            self._fail(f"face {n_ok} has zero area")
+        return _reversed_loops(flat, starts, lengths, areas < 0), lengths
+
+    def _match_faces(self, flat: np.ndarray, lengths: np.ndarray) -> np.ndarray:
+        """(E, 2) int: face on the left / right of each edge (u→v), −1 if none.
+
+        Sides are matched in face order, side by side; the first side that is
+        not an edge, or that repeats an edge side already taken, is named.
+        """
+        n, n_edges = self.n_vertices, self.n_edges
+        keys = np.concatenate([self.edges[:, 0] * n + self.edges[:, 1],
+                               self.edges[:, 1] * n + self.edges[:, 0]])
+        order = np.argsort(keys)
+        u, v = flat, flat[next_in_loop(loop_starts(lengths), lengths)]
+        side_key = u * n + v
+        at = np.minimum(np.searchsorted(keys[order], side_key), len(keys) - 1)
+        slot = order[at]  # e (left) or e + E (right)
+        missing = keys[slot] != side_key
+        face_of = np.repeat(np.arange(len(lengths)), lengths)
+        by_slot = np.argsort(np.where(missing, -1, slot), kind="stable")
+        taken = np.zeros(len(flat), dtype=bool)  # the slot was filled before, in order
+        same = slot[by_slot][1:] == slot[by_slot][:-1]
+        taken[by_slot[1:][same & ~missing[by_slot][1:]]] = True
+        wrong = missing | taken
+        if wrong.any():
+            k = int(np.argmax(wrong))
+            if missing[k]:
+                self._fail(f"face {face_of[k]}: its side {int(u[k])}→{int(v[k])} is not an edge")
+            e = int(slot[k] % n_edges)
+            earlier = face_of[np.flatnonzero(slot == slot[k])[0]]
+            self._fail(f"edge {e} has faces {earlier} and {face_of[k]} on the "
+                       "same side (overlapping faces)")
+        edge_faces = np.full((n_edges, 2), -1, dtype=np.int64)
+        edge_faces[slot % n_edges, slot // n_edges] = face_of
         n_sides = (edge_faces >= 0).sum(axis=1)
         for e in np.flatnonzero(n_sides == 0):
             self._fail(f"edge {e} belongs to no face")
@@ -219,6 +262,41 @@ class CreasePattern:
         for e in np.flatnonzero((n_sides == 2) & (self.assignments == "B")):
             self._fail(f"edge {e} is assigned 'B' but has faces on both sides")
         return edge_faces
+
+
+def _face_loops(faces) -> tuple[np.ndarray, np.ndarray]:
+    """Faces (a sequence of vertex-id sequences) as concatenated ids and lengths.
+
+    Lists of Python ints and 1-D integer arrays are joined at once; anything
+    else is coerced face by face with ``np.asarray(face, dtype=np.int64)``.
+    """
+    faces = list(faces)
+    kinds = set(map(type, faces))
+    if kinds <= {list, tuple} and set(map(type, chain.from_iterable(faces))) <= {int}:
+        lengths = np.fromiter(map(len, faces), dtype=np.int64, count=len(faces))
+        try:
+            flat = np.fromiter(chain.from_iterable(faces), dtype=np.int64,
+                               count=int(lengths.sum()))
+        except OverflowError:  # an id beyond int64: out of range, as the slow path says
+            flat = None
+        if flat is not None:
+            return flat, lengths
+    if not (kinds <= {np.ndarray} and all(f.ndim == 1 and f.dtype.kind in "iu" for f in faces)):
+        faces = [np.asarray(face, dtype=np.int64).ravel() for face in faces]
+    lengths = np.fromiter(map(len, faces), dtype=np.int64, count=len(faces))
+    flat = np.concatenate(faces).astype(np.int64, copy=False) if faces \
+        else np.zeros(0, dtype=np.int64)
+    return flat, lengths
+
+
+def _reversed_loops(flat, starts, lengths, flip) -> np.ndarray:
+    """``flat`` with the loops where ``flip`` is True in reverse vertex order."""
+    if not flip.any():
+        return flat
+    face_of = np.repeat(np.arange(len(lengths)), lengths)
+    index = np.arange(len(flat))
+    mirror = 2 * starts[face_of] + lengths[face_of] - 1 - index
+    return flat[np.where(flip[face_of], mirror, index)]
 
 
 # ------------------------------------------------------------------ coercion
@@ -286,6 +364,10 @@ def _as_edges(edges, n_vertices: int, source: str) -> np.ndarray:
 
 
 def _as_assignments(assignments, n_edges: int, source: str) -> np.ndarray:
+    if _all_known(assignments):  # at once; else item by item, naming the first bad one
+        if len(assignments) != n_edges:
+            raise PatternError(f"{source}: {len(assignments)} assignments for {n_edges} edges")
+        return np.array(assignments, dtype="<U1")
     a = [str(x) for x in assignments]
     if len(a) != n_edges:
         raise PatternError(f"{source}: {len(a)} assignments for {n_edges} edges")
@@ -298,6 +380,15 @@ def _as_assignments(assignments, n_edges: int, source: str) -> np.ndarray:
             raise PatternError(f"{source}: edge {e} has unknown assignment {kind!r} "
                                f"(expected one of {', '.join(ASSIGNMENTS)})")
     return np.array(a, dtype="<U1")
+
+
+def _all_known(assignments) -> bool:
+    """True for a 1-D str array or a list/tuple of str, every one in ASSIGNMENTS."""
+    if isinstance(assignments, np.ndarray):
+        return assignments.ndim == 1 and assignments.dtype.kind == "U" \
+            and bool(np.isin(assignments, ASSIGNMENTS).all())
+    return isinstance(assignments, (list, tuple)) and set(map(type, assignments)) <= {str} \
+        and set(assignments) <= set(ASSIGNMENTS)
 
 
 def _per_edge(values, n_edges: int, default: float, name: str, source: str) -> np.ndarray:

@@ -37,17 +37,24 @@ foldcore's own keys (lengths in the file's ``frame_unit``; foldcore writes mm):
 
 Every malformed input raises :class:`PatternError` naming the file and the
 offending item; files above :data:`MAX_FILE_BYTES` are refused unread.
+
+Large files: arrays of plain numbers, ids and letters are checked with NumPy;
+from the first item that may be bad on, the row-by-row checks run, so the
+message names the same item. A 10⁶-vertex triangulated grid (154 MB) reads
+in about 19 s with a 2.6 GB peak, mostly the parsed JSON's Python objects
+(``bench/reading.py``); a file at the size limit would need about 4.5 GB.
 """
 from __future__ import annotations
 
 import errno
+import gc
 import json
 import os
 import secrets
-from collections import Counter
 from contextlib import contextmanager, suppress
 from dataclasses import dataclass
 from functools import partial
+from itertools import chain
 
 import numpy as np
 
@@ -55,7 +62,7 @@ from .. import limits
 from ..errors import PatternError
 from ..hinges import HINGE_MODELS
 from ..pattern import DEFAULT_MAX_ANGLE_DEG, CreasePattern
-from ..planar import derive_faces
+from ..planar import derive_face_loops, has_repeats, loop_starts, next_in_loop
 
 #: Largest input file read, bytes (256 MiB).
 MAX_FILE_BYTES = 256 * 1024 * 1024
@@ -75,6 +82,8 @@ POISSON_KEY = "foldcore:edges_poisson"
 HINGE_KEY = "foldcore:edges_hinge"
 #: What a JSON array may be in a FOLD dict: a list, or a tuple from a Python caller.
 ARRAY = (list, tuple)
+#: Digits to "0" and "E" to "e", for :func:`_may_overflow`'s plain substring search.
+_DIGITS_TO_ZERO = bytes.maketrans(b"123456789E", b"000000000e")
 
 
 @dataclass(frozen=True)
@@ -204,15 +213,41 @@ def _parse_json(data: bytes, source: str):
         text = data.decode("utf-8-sig")
     except UnicodeDecodeError as exc:
         _fail(source, f"not UTF-8 text (bad byte at offset {exc.start})")
+    # every float is checked by a Python hook only when one could overflow; the
+    # parser's many lists are freed by reference counting, so the cyclic GC's
+    # passes over them (half of a 10⁶-vertex file's parse) are paused meanwhile
+    hook = {"parse_float": partial(_finite_float, source)} if _may_overflow(data) else {}
     try:
-        return json.loads(text, parse_constant=partial(_bad_constant, source),
-                          parse_float=partial(_finite_float, source))
+        with _gc_paused():
+            return json.loads(text, parse_constant=partial(_bad_constant, source), **hook)
     except PatternError:
         raise
     except json.JSONDecodeError as exc:
         _fail(source, f"not valid JSON: {exc.msg} at line {exc.lineno}, column {exc.colno}")
     except (ValueError, RecursionError) as exc:
         _fail(source, f"not valid JSON ({type(exc).__name__}: {exc})")
+
+
+def _may_overflow(data: bytes) -> bool:
+    """False only if no JSON number in ``data`` can overflow a float64.
+
+    A float overflows only beyond 1.8e308, so it needs an exponent of three
+    or more digits or a hundred digits in a row (≤ 99 digits × 10⁹⁹ is finite).
+    """
+    t = data.translate(_DIGITS_TO_ZERO)
+    return any(p in t for p in (b"0" * 100, b"e000", b"e+000"))
+
+
+@contextmanager
+def _gc_paused():
+    """Pause the cyclic garbage collector (if on) for the block."""
+    enabled = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        if enabled:
+            gc.enable()
 
 
 def _bad_constant(source: str, name: str):
@@ -235,9 +270,28 @@ def _unit_scale(d: dict, source: str) -> tuple[str, float]:
     return unit, UNIT_MM[unit]
 
 
-def _coords(d: dict, scale: float, source: str) -> list[list[float]]:
+def _coords(d: dict, scale: float, source: str):
+    """(V, 2) vertex coordinates in mm (``[]`` for none), checked at once when the rows
+    are plain [x, y] or [x, y, z] lists; from the first suspect row on, row by row."""
+    rows = _required_list(d, "vertices_coords", source)
+    xy = _number_table(rows, (2, 3))
+    if xy is None:
+        return _coords_by_row(rows, scale, source, 0)
+    with np.errstate(over="ignore", invalid="ignore"):
+        mm = xy[:, :2] * scale
+    bad = ~np.isfinite(xy).all(axis=1) | ~np.isfinite(mm).all(axis=1)
+    if xy.shape[1] == 3:
+        bad |= xy[:, 2] != 0
+    if not bad.any():
+        return mm
+    first = int(np.argmax(bad))
+    return np.concatenate([mm[:first], _coords_by_row(rows, scale, source, first)])
+
+
+def _coords_by_row(rows, scale: float, source: str, start: int):
+    """Rows ``start``... of vertices_coords checked one by one, as (n, 2) mm."""
     out = []
-    for i, row in enumerate(_required_list(d, "vertices_coords", source)):
+    for i, row in enumerate(rows[start:], start):
         xyz = [_number(x) for x in row] if isinstance(row, ARRAY) else []
         if not 2 <= len(xyz) <= 3 or None in xyz:
             _fail(source, f"vertices_coords[{i}] (vertex {i}) must be 2 or 3 finite "
@@ -247,12 +301,26 @@ def _coords(d: dict, scale: float, source: str) -> list[list[float]]:
                           "(frame 0) must be flat (z = 0)")
         out.append([_scaled(x, scale, f"vertices_coords[{i}] (vertex {i})", source)
                     for x in xyz[:2]])
-    return out
+    return out if start == 0 else np.array(out, dtype=np.float64).reshape(-1, 2)
 
 
-def _edges(d: dict, n_vertices: int, source: str) -> list[list[int]]:
+def _edges(d: dict, n_vertices: int, source: str):
+    """(E, 2) vertex ids (``[]`` for none); at once for plain [u, v] int lists."""
+    rows = _required_list(d, "edges_vertices", source)
+    ids = _int_table(rows, 2)
+    if ids is None:
+        return _edges_by_row(rows, n_vertices, source, 0)
+    bad = ((ids < 0) | (ids >= n_vertices)).any(axis=1)
+    if not bad.any():
+        return ids
+    first = int(np.argmax(bad))
+    return np.concatenate([ids[:first], _edges_by_row(rows, n_vertices, source, first)])
+
+
+def _edges_by_row(rows, n_vertices: int, source: str, start: int):
+    """Rows ``start``... of edges_vertices checked one by one."""
     out = []
-    for i, row in enumerate(_required_list(d, "edges_vertices", source)):
+    for i, row in enumerate(rows[start:], start):
         if not isinstance(row, ARRAY) or len(row) != 2:
             _fail(source, f"edges_vertices[{i}] (edge {i}) must be [u, v], got {_short(row)}")
         ids = [_index(x, n_vertices) for x in row]
@@ -260,7 +328,7 @@ def _edges(d: dict, n_vertices: int, source: str) -> list[list[int]]:
             _fail(source, f"edge {i} refers to vertices {_short(row)}, but there are "
                           f"{n_vertices} vertices (ids 0..{n_vertices - 1})")
         out.append(ids)
-    return out
+    return out if start == 0 else np.array(out, dtype=np.int64).reshape(-1, 2)
 
 
 def _faces(d: dict, n_vertices: int, source: str) -> list[list[int]] | None:
@@ -269,8 +337,11 @@ def _faces(d: dict, n_vertices: int, source: str) -> list[list[int]] | None:
         return None
     if not isinstance(raw, ARRAY):
         _fail(source, f"faces_vertices must be a list, got {type(raw).__name__}")
-    out = []
-    for i, row in enumerate(raw):
+    first = _first_bad_face(raw, n_vertices)
+    if first is None:
+        return list(raw)
+    out = [list(row) for row in raw[:first]]
+    for i, row in enumerate(raw[first:], first):
         ids = [_index(x, n_vertices) for x in row] if isinstance(row, ARRAY) else [None]
         if None in ids:
             _fail(source, f"faces_vertices[{i}] (face {i}) must list vertex ids "
@@ -279,11 +350,57 @@ def _faces(d: dict, n_vertices: int, source: str) -> list[list[int]] | None:
     return out
 
 
+def _first_bad_face(raw, n_vertices: int) -> int | None:
+    """None if every face is a list of int ids in range, else the first face that may
+    not be (0 when the faces are not plain int lists)."""
+    if not set(map(type, raw)) <= {list, tuple} \
+            or not set(map(type, chain.from_iterable(raw))) <= {int}:
+        return 0
+    lengths = np.fromiter(map(len, raw), dtype=np.int64, count=len(raw))
+    try:
+        flat = np.fromiter(chain.from_iterable(raw), dtype=np.int64, count=int(lengths.sum()))
+    except OverflowError:
+        return 0
+    bad = (flat < 0) | (flat >= n_vertices)
+    if not bad.any():
+        return None
+    return int(np.searchsorted(np.cumsum(lengths), np.argmax(bad), side="right"))
+
+
+def _number_table(rows, widths: tuple) -> np.ndarray | None:
+    """``rows`` as an (n, k) float array if they are lists/tuples of one length k in
+    ``widths`` holding only int/float (not bool); None otherwise (check row by row)."""
+    if not rows or not set(map(type, rows)) <= {list, tuple}:
+        return None
+    lengths = set(map(len, rows))
+    if len(lengths) != 1 or not lengths <= set(widths) \
+            or not set(map(type, chain.from_iterable(rows))) <= {int, float}:
+        return None
+    try:
+        return np.array(rows, dtype=np.float64)
+    except (OverflowError, ValueError, TypeError):  # e.g. an int beyond float range
+        return None
+
+
+def _int_table(rows, width: int) -> np.ndarray | None:
+    """``rows`` as an (n, width) int64 array if they are lists/tuples of ``width`` ints
+    (not bool); None otherwise (check row by row)."""
+    if not rows or not set(map(type, rows)) <= {list, tuple} or set(map(len, rows)) != {width} \
+            or not set(map(type, chain.from_iterable(rows))) <= {int}:
+        return None
+    try:
+        return np.array(rows, dtype=np.int64)
+    except OverflowError:
+        return None
+
+
 def _assignments(d: dict, vertices, edges, source: str) -> list[str]:
     raw = d.get("edges_assignment")
     if raw is None:
         return _default_assignments(vertices, edges, source)
     _check_length(raw, "edges_assignment", len(edges), source)
+    if set(map(type, raw)) <= {str} and set(raw) <= set("MVBFU"):
+        return list(raw)  # the usual case, nothing to convert
     for i, a in enumerate(raw):
         if not isinstance(a, str):
             _fail(source, f"edges_assignment[{i}] (edge {i}) must be a string, got {_short(a)}")
@@ -291,19 +408,29 @@ def _assignments(d: dict, vertices, edges, source: str) -> list[str]:
 
 
 def _default_assignments(vertices, edges, source: str) -> list[str]:
-    """``U`` for edges with faces on both sides, ``B`` for the others."""
+    """``U`` for edges with faces on both sides, ``B`` for the others.
+
+    A graph with an edge from a vertex to itself or an edge twice has no
+    faces to derive: all ``U``, and CreasePattern names the edge.
+    """
     v = np.asarray(vertices, dtype=np.float64).reshape(-1, 2)
     e = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
+    if not len(e) or has_repeats(e):
+        return ["U"] * len(e)
     try:
         with np.errstate(all="ignore"):  # huge coordinates: CreasePattern refuses them
-            faces = derive_faces(v, e, np.zeros(len(e), dtype=bool), source)
+            flat, lengths = derive_face_loops(v, e, np.zeros(len(e), dtype=bool), source)
     except PatternError:
         raise
     except Exception:  # malformed graph: let CreasePattern name the problem
         return ["U"] * len(e)
-    sides = Counter(frozenset(side) for f in faces
-                    for side in zip(f.tolist(), np.roll(f, -1).tolist()))
-    return ["U" if sides[frozenset(pair)] >= 2 else "B" for pair in e.tolist()]
+    u, w = flat, flat[next_in_loop(loop_starts(lengths), lengths)]
+    n = len(v)
+    sides, counts = np.unique(np.minimum(u, w) * n + np.maximum(u, w), return_counts=True)
+    key = e.min(axis=1) * n + e.max(axis=1)
+    at = np.minimum(np.searchsorted(sides, key), max(len(sides) - 1, 0))
+    two = (sides[at] == key) & (counts[at] >= 2) if len(sides) else np.zeros(len(e), bool)
+    return np.where(two, "U", "B").tolist()
 
 
 def _per_edge(d: dict, key: str, n_edges: int, source: str) -> list | None:
@@ -316,12 +443,26 @@ def _per_item(d: dict, key: str, n: int, item: str, source: str) -> list | None:
     if raw is None:
         return None
     _check_length(raw, key, n, source, item)
+    if _plain_numbers(raw):
+        return list(raw) if int not in set(map(type, raw)) else \
+            [None if x is None else float(x) for x in raw]
     out = [None if x is None else _number(x) for x in raw]
     for i, (x, value) in enumerate(zip(raw, out)):
         if x is not None and value is None:
             _fail(source, f"{key}[{i}] ({item} {i}) must be a finite number or null, "
                           f"got {_short(x)}")
     return out
+
+
+def _plain_numbers(raw) -> bool:
+    """True if ``raw`` holds only None and finite int/float (not bool), checked at once."""
+    if not raw or not set(map(type, raw)) <= {int, float, type(None)}:
+        return False
+    try:
+        values = np.array(raw, dtype=np.float64)  # None → NaN
+    except (OverflowError, ValueError, TypeError):
+        return False
+    return not np.isinf(values).any() and np.isnan(values).sum() == raw.count(None)
 
 
 def faces_cells(d: dict, n_faces: int, source: str) -> dict:

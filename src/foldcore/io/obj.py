@@ -54,6 +54,7 @@ import numpy as np
 from .. import limits
 from ..errors import PatternError
 from ..pattern import DEFAULT_MAX_ANGLE_DEG, CreasePattern
+from ..planar import loop_starts, next_in_loop
 from .fold import _build, _short, atomic_write, read_bytes
 
 HINGE_SUFFIX = ".hinges"
@@ -78,19 +79,22 @@ def mesh_edges(faces) -> np.ndarray:
 
 
 def _edge_table(faces) -> tuple[np.ndarray, np.ndarray]:
-    """(E, 2) edges in hinge-file order and (E,) number of faces on each."""
-    index: dict[tuple[int, int], int] = {}
-    edges, counts = [], []
-    for face in faces:
-        face = [int(v) for v in face]
-        for a, b in zip(face, face[1:] + face[:1]):
-            key = (min(a, b), max(a, b))
-            if key not in index:
-                index[key] = len(edges)
-                edges.append((a, b))
-                counts.append(0)
-            counts[index[key]] += 1
-    return np.array(edges, dtype=np.int64).reshape(-1, 2), np.array(counts, dtype=np.int64)
+    """(E, 2) edges in hinge-file order and (E,) number of faces on each.
+
+    At once: the sides of all faces in file order, each keyed by its sorted
+    vertex pair; an edge is a key's first side, edges ordered by that side.
+    """
+    faces = [f for f in faces if len(f)]  # an empty face has no sides
+    lengths = np.fromiter(map(len, faces), dtype=np.int64, count=len(faces))
+    if not faces:
+        return np.zeros((0, 2), dtype=np.int64), np.zeros(0, dtype=np.int64)
+    flat = np.concatenate([np.asarray(f, dtype=np.int64).ravel() for f in faces])
+    a, b = flat, flat[next_in_loop(loop_starts(lengths), lengths)]
+    lo, hi = np.minimum(a, b), np.maximum(a, b)
+    key = (lo - lo.min()) * (int(hi.max()) - int(lo.min()) + 1) + (hi - lo.min())
+    _, first, counts = np.unique(key, return_index=True, return_counts=True)
+    order = np.argsort(first)
+    return np.stack([a[first[order]], b[first[order]]], axis=1), counts[order]
 
 
 # ------------------------------------------------------------------- reading
@@ -208,9 +212,8 @@ def parse_stl(data: bytes, source: str) -> tuple[np.ndarray, list[np.ndarray]]:
     count = int.from_bytes(data[80:84], "little")
     if len(data) >= 84 and len(data) == 84 + 50 * count:
         records = np.frombuffer(data, dtype=_STL_RECORD, count=count, offset=84)
-        polygons = [(f"{source}, facet {i}", tri.tolist())
-                    for i, tri in enumerate(records["v"].astype(np.float64))]
-    elif b"\0" in data:  # ASCII STL is text: a damaged binary STL
+        return _merge_triangles(records["v"].astype(np.float64), source)
+    if b"\0" in data:  # ASCII STL is text: a damaged binary STL
         _bad_binary_stl(data, count, source)
     else:
         polygons = _ascii_stl_loops(_text(data), source)
@@ -250,6 +253,35 @@ def _ascii_stl_loops(text: str, source: str) -> list[tuple[str, list]]:
         raise PatternError(f"{current[0]}: this 'outer loop' has no 'endloop' "
                            "(file truncated?)")
     return loops
+
+
+def _merge_triangles(tris: np.ndarray, source: str) -> tuple[np.ndarray, list[np.ndarray]]:
+    """:func:`_merge_vertices` of a binary STL's (F, 3, 3) facets, at once.
+
+    The first vertex that is not finite with z = 0 is named as before;
+    vertices with equal (x, y) (0.0 and -0.0 alike, as dict keys) are merged,
+    numbered in order of first appearance, keeping the first one's values.
+    """
+    xyz = tris.reshape(-1, 3)
+    bad = ~(np.isfinite(xyz[:, 0]) & np.isfinite(xyz[:, 1]) & (xyz[:, 2] == 0))
+    if bad.any():
+        k = int(np.argmax(bad))
+        x, y, z = xyz[k].tolist()
+        raise PatternError(f"{source}, facet {k // 3}: vertex ({x:g}, {y:g}, {z:g}) must be "
+                           "finite with z = 0 (the pattern lies flat)")
+    xy = xyz[:, :2] + 0.0  # -0.0 → 0.0: equal keys, as in a dict
+    order = np.lexsort((xy[:, 1], xy[:, 0]))
+    step = np.ones(len(xy), dtype=bool)
+    step[1:] = (np.diff(xy[order], axis=0) != 0).any(axis=1)
+    group = np.cumsum(step) - 1  # per sorted corner: its (x, y) class
+    first = np.full(int(group[-1]) + 1 if len(group) else 0, len(xy), dtype=np.int64)
+    np.minimum.at(first, group, order)  # each class's first corner
+    rank = np.empty(len(first), dtype=np.int64)
+    rank[np.argsort(first)] = np.arange(len(first))
+    ids = np.empty(len(xy), dtype=np.int64)
+    ids[order] = rank[group]
+    vertices = xyz[np.sort(first), :2]
+    return np.ascontiguousarray(vertices).reshape(-1, 2), list(ids.reshape(-1, 3))
 
 
 def _merge_vertices(polygons) -> tuple[np.ndarray, list[np.ndarray]]:
