@@ -25,7 +25,7 @@ from contextlib import contextmanager
 
 import numpy as np
 import pytest
-from hypothesis import event, example, given
+from hypothesis import event, given
 from hypothesis import strategies as st
 
 from foldcore import patterns
