@@ -21,6 +21,7 @@ one line per kind, with a count of the repeats.
 from __future__ import annotations
 
 import argparse
+import math
 import re
 import sys
 import threading
@@ -28,6 +29,7 @@ import warnings
 
 from .hinges import DEFAULT_HINGE, HINGE_MODELS
 from .actuation import ACTUATIONS, BRANCH_FLOOR_DEG, DEFAULT_ACTUATION
+from .destinations import check_destinations
 from .strategies import DEFAULT_SOLVER, SOLVERS
 
 EXIT_BAD_INPUT = 2
@@ -238,7 +240,6 @@ def _load(args):
 
 def simulate(args) -> int:
     """Run ``foldcore simulate``; raises FoldcoreError on bad input."""
-    from .destinations import check_destinations
     from .errors import SimulationError
     from .outputs import write_result
     from .simulation import Simulation
@@ -282,8 +283,8 @@ def simulate(args) -> int:
 
 def _why(result) -> str:
     """Why a run ended unconverged, in words (Result.reason and residual)."""
-    far = (f", the equilibrium estimated {result.residual:.1e} × the pattern size away"
-           if result.residual == result.residual else "")  # NaN: never estimated
+    far = ("" if math.isnan(result.residual) else  # NaN: never estimated
+           f", the equilibrium estimated {result.residual:.1e} × the pattern size away")
     return {"stalled": "stalled: steps within the tolerance" + far,
             "budget": "--max-iterations reached" + far,
             "callback": "stopped"}.get(result.reason, result.reason)
@@ -315,8 +316,6 @@ def render_result(args) -> int:
     from .measure import fold_angles
     from .render import colour_limits, per_strip, render_png, strip_bend_angles
 
-    from .destinations import check_destinations
-
     check_destinations({"-o": args.output}, inputs=(args.result,), suffixes={"-o": (".png",)})
     res = read_result(args.result, args.hinge_width, args.subdivisions)
     options = {}
@@ -342,8 +341,6 @@ def render_result(args) -> int:
 def export_result(args) -> int:
     """Run ``foldcore export``; raises FoldcoreError on bad input."""
     from .fabrication import ExportError, export, read_result
-
-    from .destinations import check_destinations
 
     if not (args.svg or args.dxf or args.stl):
         raise ExportError(f"{args.result}: nothing to export: give --svg, --dxf and/or --stl")

@@ -104,7 +104,6 @@ class Result:
     residual: float = float("nan")
 
 
-
 class _GroupRun:
     """Run-time arrays of one element group: parameters, outputs, state.
 
@@ -517,15 +516,15 @@ class Simulation:
         self.runs += 1
         self.timings.setdefault("total", self.timings["setup"])
         budget, limit = int(max_iterations), tolerance * self.length_scale
-        reason = "budget"
+        reason = "budget"  # unless the (released) stage ends otherwise
         with blas_on_one_thread(self.threads > 1):
             if self._starts_flat():
-                used, reason = self._branch_stage(budget, callback, limit)
+                used, branch = self._branch_stage(budget, callback, limit)
                 budget -= used
+                if branch == "callback":
+                    reason = branch
             if budget > 0 and reason != "callback":
                 _, reason = self._stage(budget, callback, limit)
-            elif reason != "callback":
-                reason = "budget"  # the released stage has yet to settle
         self.timings["total"] += time.perf_counter() - start
         self.timings["bare_solve"] = self._bare_solve_floor()
         return self.result(reason == "converged", reason)

@@ -112,7 +112,7 @@ class EquilibriumCheck:
         self.failed = not (self.residual <= relative
                            and (resolved or self._energy_fell(relative)))
         if self.failed:
-            self._next = sim.iterations + max(PROBE_STEPS, sim.iterations - self._start)
+            self._probe_later()
         else:
             hold = max(HOLD, (sim.iterations - self._start) // 10)
             self._anchor = (sim.iterations + hold, sim.x.copy(), sim.iterations)
@@ -134,8 +134,14 @@ class EquilibriumCheck:
         self.residual = max(self.residual, drift / sim.length_scale)
         self.failed = not drift <= max(limit, RESOLUTION * sim.length_scale)
         if self.failed:
-            self._next = sim.iterations + max(PROBE_STEPS, sim.iterations - self._start)
+            self._probe_later()
         return not self.failed
+
+    def _probe_later(self) -> None:
+        """After a failed check: the next probe waits as many iterations as the stage
+        has taken, at least ``PROBE_STEPS``."""
+        iterations = self.sim.iterations
+        self._next = iterations + max(PROBE_STEPS, iterations - self._start)
 
     def _energy_fell(self, relative: float) -> bool:
         """Whether the energy fell to ``ENERGY_LEFT`` of the run's largest, or to
