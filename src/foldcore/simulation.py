@@ -517,6 +517,7 @@ class Simulation:
         self.timings.setdefault("total", self.timings["setup"])
         budget, limit = int(max_iterations), tolerance * self.length_scale
         reason = "budget"  # unless the (released) stage ends otherwise
+        self.equilibrium.begin_run()
         with blas_on_one_thread(self.threads > 1):
             if self._starts_flat():
                 used, branch = self._branch_stage(budget, callback, limit)
@@ -686,6 +687,7 @@ class Simulation:
     def _targets_changed(self) -> None:
         """Targets moved: the strategy's history (energies, gradients) is stale."""
         self.strategy.targets_changed()
+        self.equilibrium.targets_changed()
 
     def _check_every_vertex_used(self) -> None:
         """A vertex in no element has no equation: K would be singular there."""
