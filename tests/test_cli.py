@@ -84,8 +84,9 @@ def test_a_stalled_run_says_so_in_the_report_and_on_stderr(tmp_path, capsys):
     assert rep["fold_angles_deg"][0] < 80.0
     assert rep["converged"] is False and rep["reason"] == "stalled"
     assert rep["residual"] is None or rep["residual"] > 1e-8
-    (line,) = capsys.readouterr().err.splitlines()
-    assert str(path) in line and "stalled" in line
+    warning, summary = capsys.readouterr().err.splitlines()
+    assert str(path) in warning and "stalled" in warning
+    assert summary.startswith(f"foldcore: {path}: not converged (stalled) after ")
 
 
 def _edit(fold_file, tmp_path, change) -> str:

@@ -245,9 +245,9 @@ BAD_FOLDS = {  # name: (file text, substrings the message must contain)
               ["foldcore:edges_hinge[6]", "edge 6", "'axis'"]),
     # frame 0 must be flat: a vertex below the sheet is refused as firmly as one above
     "below": (json.dumps(_mutate(fold_json(two_squares()), "vertices_coords", 3, [2, 1, -0.5])),
-              ["vertex 3", "z = -0.5", "flat"]),
+              ["vertex 3", "z = -0.5", "one plane"]),
     "above": (json.dumps(_mutate(fold_json(two_squares()), "vertices_coords", 3, [2, 1, 0.5])),
-              ["vertex 3", "z = 0.5", "flat"]),
+              ["vertex 3", "z = 0.5", "one plane"]),
     "toplevel": ("[1, 2]", ["JSON object"]),
     "missing": ('{"vertices_coords": []}', ["edges_vertices"]),
 }

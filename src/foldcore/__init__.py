@@ -9,13 +9,17 @@ Data flow: pattern → thick mesh → system → simulation → result → outpu
     result = sim.run(tolerance=1e-9)
     result.fold_angles_deg[0]          # ≈ 90 (degrees, valley > 0)
 
+    # or from a file, as the command line does (foldcore.job):
+    result = foldcore.simulate("crane.fold", thickness=0.5, sheet_size=200,
+                               fold_percent=30, output="crane-30.fold")
+
 Units: mm and degrees at every public API. Submodules are imported lazily so
 that ``import foldcore`` is fast and never imports numba kernels or pyvista.
 """
 from importlib import import_module
 
 from .errors import (FoldcoreError, KernelCacheWarning, MeshError, PatternError, PatternWarning,
-                     SimulationError)
+                     RunWarning, SimulationError)
 
 __version__ = "0.1.0"
 
@@ -26,13 +30,15 @@ _LAZY = {
     "Simulation": ("foldcore.simulation", "Simulation"),
     "Result": ("foldcore.simulation", "Result"),
     "read": ("foldcore.io", "read"),
+    "simulate": ("foldcore.job", "simulate"),
+    "Reading": ("foldcore.io", "Reading"),
     "write_fold": ("foldcore.io", "write_fold"),
     "patterns": ("foldcore.patterns", None),
     "kinematics": ("foldcore.kinematics", None),
 }
 
 __all__ = ["FoldcoreError", "KernelCacheWarning", "MeshError", "PatternError", "PatternWarning",
-           "SimulationError", *_LAZY]
+           "RunWarning", "SimulationError", *_LAZY]
 
 
 def __getattr__(name):

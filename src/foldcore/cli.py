@@ -120,6 +120,20 @@ def build_parser() -> argparse.ArgumentParser:
     sim = sub.add_parser("simulate", help="fold a crease pattern (FOLD, or OBJ/STL + hinges)")
     sim.add_argument("pattern", help="crease pattern: .fold, or .obj/.stl with a .hinges file")
     sim.add_argument("--hinges", help="hinge file of an OBJ/STL pattern (default: PATTERN.hinges)")
+    sim.add_argument("--mv-passive", action="store_true",
+                     help="in a FOLD file without edges_foldAngle, M/V creases stay passive "
+                          "(default: they fold to -/+180 degrees x the fold percent, as in "
+                          "Origami Simulator)")
+    sim.add_argument("--trust-assignment", action="store_true",
+                     help="an angle whose sign contradicts its M/V assignment takes the "
+                          "assignment's sign (default: refused, naming the edge)")
+    size = sim.add_mutually_exclusive_group()
+    size.add_argument("--scale", type=_positive, metavar="FACTOR",
+                      help="multiply every length of the pattern file (after its "
+                           "frame_unit) by FACTOR")
+    size.add_argument("--sheet-size", type=_positive, metavar="MM",
+                      help="scale the pattern so that its larger extent is MM millimetres "
+                           "(a unit-square file is otherwise 1 mm wide)")
     sim.add_argument("--thickness", type=_positive,
                      help="sheet thickness H in mm (default: the file's foldcore:thickness)")
     sim.add_argument("--hinge-width", type=_positive,
@@ -155,6 +169,8 @@ def build_parser() -> argparse.ArgumentParser:
                      help="from a flat sheet, first fold with passive M/V creases held at "
                           "least DEG degrees on their assigned side, then release them "
                           f"(branch selection; 0 turns it off; default {BRANCH_FLOOR_DEG:g})")
+    sim.add_argument("-q", "--quiet", action="store_true",
+                     help="no summary line on stderr (warnings and errors are still said)")
     sim.add_argument("-o", "--output", help="write the result as FOLD (achieved angles + "
                                             "folded solid in file_frames)")
     sim.add_argument("--report", help="write the JSON report here")
@@ -222,63 +238,27 @@ def run_scene(args) -> int:
     return 0
 
 
-def _load(args):
-    from .io import read, read_fold_file
-    from .errors import PatternError
-    from .limits import check_inputs
-
-    if args.pattern.lower().endswith(".fold"):
-        if args.hinges:
-            raise PatternError(f"{args.pattern}: --hinges only goes with an OBJ/STL pattern")
-        fold = read_fold_file(args.pattern)
-        loaded = fold.pattern, fold.thickness, fold.stiffness, fold.hinge
-    else:
-        loaded = read(args.pattern, hinges=args.hinges), None, None, None
-    check_inputs(loaded[0], args.thickness, args.hinge_width, loaded[2])
-    return loaded
-
-
 def simulate(args) -> int:
-    """Run ``foldcore simulate``; raises FoldcoreError on bad input."""
-    from .errors import SimulationError
-    from .outputs import write_result
-    from .simulation import Simulation
-    from .thickening import thicken
+    """Run ``foldcore simulate`` (:func:`foldcore.job.fold`); raises FoldcoreError on
+    bad input."""
+    from .job import fold
 
-    if args.max_iterations < 1:
-        raise SimulationError(f"--max-iterations must be ≥ 1, got {args.max_iterations}")
-    pattern, file_thickness, stiffness, file_hinges = _load(args)
-    thickness = args.thickness or file_thickness
-    if thickness is None:
-        raise SimulationError(f"{args.pattern}: no thickness: pass --thickness H (mm) "
-                              "or set foldcore:thickness in the file")
-    check_destinations({"-o": args.output, "--report": args.report, "--render": args.render,
-                        "--animate": args.animate}, inputs=(args.pattern, args.hinges),
-                       suffixes={"--render": (".png",)})
-    if args.animate:
-        from .animate import check_output
-        check_output(args.animate)          # a missing encoder fails before any work
-    mesh = thicken(pattern, thickness, args.hinge_width, args.subdivisions,
-                   hinge=args.hinge or file_hinges, stiffness=stiffness)
-    sim = Simulation(mesh, pattern, solver=args.solver, actuation=args.actuation,
-                     branch_floor_deg=args.branch_floor)
-    if args.animate:
-        result = _animate(args, sim)
-    else:
-        sim.set_fold_percent(args.fold_percent)
-        result = sim.run(tolerance=args.tolerance, max_iterations=args.max_iterations)
+    done = fold(args.pattern, **{name: getattr(args, name) for name in _SIMULATE_OPTIONS})
+    result = done.result
     if not result.converged:
         print(f"foldcore: warning: {args.pattern}: not converged after {result.iterations} "
               f"iterations ({_why(result)}; tolerance {args.tolerance:g}); the result is "
               "the last iterate", file=sys.stderr)
-    settings = {k: getattr(args, k) for k in ("pattern", "fold_percent", "solver",
-                                              "tolerance", "max_iterations", "subdivisions")}
-    settings.update(thickness_mm=thickness, hinge=sorted(set(mesh.hinge_model) - {""}),
-                    actuation=args.actuation, branch_floor_deg=args.branch_floor,
-                    backend=sim.system.factor.backend)
-    write_result(result, pattern, mesh, thickness, settings, fold=args.output,
-                 report=args.report, png=args.render)
+    if not args.quiet:
+        print(done.summary, file=sys.stderr)
     return 0
+
+
+#: ``simulate`` options passed to :func:`foldcore.job.fold` under their own names.
+_SIMULATE_OPTIONS = ("thickness", "hinge_width", "subdivisions", "fold_percent", "solver",
+                     "tolerance", "max_iterations", "hinge", "actuation", "branch_floor",
+                     "hinges", "mv_passive", "trust_assignment", "scale", "sheet_size",
+                     "output", "report", "render", "animate", "frames", "fps")
 
 
 def _why(result) -> str:
@@ -288,20 +268,6 @@ def _why(result) -> str:
     return {"stalled": "stalled: steps within the tolerance" + far,
             "budget": "--max-iterations reached" + far,
             "callback": "stopped"}.get(result.reason, result.reason)
-
-
-def _animate(args, sim):
-    """Fold ``sim`` from 0 to --fold-percent in --frames steps, write --animate; last Result."""
-    from .animate import animate, percent_schedule
-
-    movie = animate(sim, percent_schedule(args.frames, args.fold_percent), args.animate,
-                    fps=args.fps, tolerance=args.tolerance,
-                    max_iterations=args.max_iterations)
-    unconverged = sum(not r.converged for r in movie.results[:-1])
-    if unconverged:
-        print(f"foldcore: warning: {unconverged} of {len(movie.results) - 1} intermediate "
-              "animation frames not converged", file=sys.stderr)
-    return movie.results[-1]
 
 
 def render_result(args) -> int:

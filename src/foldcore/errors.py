@@ -18,6 +18,11 @@ class PatternWarning(UserWarning):
     (for example a clockwise face reversed to counter-clockwise)."""
 
 
+class RunWarning(UserWarning):
+    """A run ended in a state the user should look at: nothing driven, or converged
+    with its targets missed (the model binds)."""
+
+
 class KernelCacheWarning(UserWarning):
     """numba could not cache kernels where it normally does (a read-only install
     without a writable home); says which folder is used instead, or that kernels

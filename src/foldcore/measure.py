@@ -47,6 +47,21 @@ def fold_angles(pattern, mesh, positions: np.ndarray) -> np.ndarray:
     d_rest = np.column_stack([d2, np.zeros(len(crease))])
     d = np.einsum("nij,nj->ni", left + right, d_rest)
     out[crease] = dihedral_deg(left[:, :, 2], right[:, :, 2], d)
+    return on_assigned_side(out, pattern.assignments)
+
+
+def on_assigned_side(angles: np.ndarray, assignments: np.ndarray) -> np.ndarray:
+    """(E,) fold angles (degrees) with an M crease past −180° written below −180°
+    and a V crease past +180° above it, instead of wrapped to the other sign.
+
+    A dihedral angle is measured in (−180°, 180°]: a mountain folded 0.54° past
+    flat reads +179.46°, which contradicts its assignment (and colours it as a
+    valley). Within 90° of its assigned side's ±180° an M or V crease keeps that
+    side's sign (−180.54°); ``U`` and ``F`` creases are left as measured."""
+    out = np.array(angles, dtype=np.float64)
+    with np.errstate(invalid="ignore"):
+        out[(assignments == "M") & (out > 90.0)] -= 360.0
+        out[(assignments == "V") & (out < -90.0)] += 360.0
     return out
 
 

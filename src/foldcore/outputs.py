@@ -45,6 +45,38 @@ def _iteration_cost(result) -> dict:
             if t["bare_solve"] > 0 else None}
 
 
+#: Degrees by which a converged run's driven creases may miss their targets before it
+#: is said to bind (its targets unreachable in this model) rather than to have folded.
+MISS_WARNING_DEG = 1.0
+
+
+def run_summary(result, pattern, source: str, fold_percent: float) -> tuple[str, list[str]]:
+    """The one-line summary of a run (verdict, iterations, time, the driven creases'
+    miss) and the warnings it calls for: nothing driven, or converged with targets
+    missed by more than :data:`MISS_WARNING_DEG`."""
+    entries = actuation_entries(result, pattern)
+    driven, worst = len(entries["creases"]), entries["largest_miss_deg"]
+    verdict = "converged" if result.converged else f"not converged ({result.reason})"
+    seconds = result.timings_s.get("total", float("nan"))
+    line = (f"foldcore: {source}: {verdict} after {result.iterations} iterations in "
+            f"{seconds:.3g} s; {driven} driven creases at fold percent {fold_percent:g}")
+    if driven:
+        line += f", miss max {worst:.3g}°, median {entries['median_miss_deg']:.3g}°"
+    warns = []
+    if not driven:
+        warns.append(f"{source}: no crease is driven (no target angles): the sheet stays "
+                     "as it is; give edges_foldAngle, or M/V creases without angles "
+                     "(and no --mv-passive)")
+    elif result.converged and worst > MISS_WARNING_DEG:
+        missed = sum(abs(c["miss_deg"]) > MISS_WARNING_DEG for c in entries["creases"])
+        warns.append(f"{source}: converged, but {missed} of {driven} driven creases miss "
+                     f"their targets by more than {MISS_WARNING_DEG:g}° (up to {worst:.3g}°): "
+                     "the model binds there — with rigid panels this pattern cannot reach "
+                     "these angles; the report's actuation lists each crease (README: "
+                     "patterns that are not rigidly foldable)")
+    return line, warns
+
+
 def actuation_entries(result, pattern) -> dict:
     """Per actuated crease: effective target, achieved angle and miss (degrees)."""
     from .measure import wrapped_deg
@@ -175,7 +207,10 @@ def write_result(result, pattern, mesh, thickness: float, settings: dict, *, fol
     thickness : float, mm (stored as ``foldcore:thickness`` in the FOLD file)
     settings : dict, recorded in the report
     fold, report, png : path or None
-        None skips it (and, for ``png``, the pyvista import). All or nothing: every
+        None skips it (and, for ``png``, the pyvista import). The FOLD file's
+        ``edges_foldAngle`` holds the achieved angles within FOLD's [−180°, 180°]
+        (a crease folded past flat on its assigned side, e.g. −180.54°, is written
+        −180°; the report keeps the measured value). All or nothing: every
         file is written to a temporary name first and renamed only when all are
         written (:func:`foldcore.destinations.all_or_nothing`).
     quantities : dict, optional
@@ -189,7 +224,8 @@ def write_result(result, pattern, mesh, thickness: float, settings: dict, *, fol
             render_png(pattern, mesh, result.positions, tmp["png"])
         if fold:
             from .io import write_fold
-            write_fold(tmp["fold"], pattern, achieved_angles=result.fold_angles_deg,
+            write_fold(tmp["fold"], pattern, achieved_angles=np.clip(  # FOLD's range
+                result.fold_angles_deg, -180.0, 180.0),
                        frames=[folded_frame(mesh, result.positions)], thickness=thickness,
                        extra=_mesh_recipe(pattern, mesh))
         if report:

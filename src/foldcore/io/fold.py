@@ -3,14 +3,17 @@
 Reading: frame 0 (the key frame) is the crease pattern; ``file_frames`` and
 unknown keys are ignored.
 
-* ``vertices_coords`` — 2D, or 3D with z = 0 (required).
+* ``vertices_coords`` — 2D, or 3D on one plane (rotated into z = 0); a folded
+  form's ``vertices_flatUnfoldCoords`` instead (:mod:`.conventions`).
 * ``edges_vertices`` — vertex ids per edge (required).
 * ``edges_assignment`` — ``M V B F U`` (lower case accepted). When absent,
   edges with a face on both sides become ``U`` and the others ``B``.
 * ``faces_vertices`` — optional; derived from the planar graph when absent,
   ``null`` or empty.
 * ``edges_foldAngle`` — degrees, valley positive: a number is an actuated
-  target, ``null`` (or no key) a passive crease.
+  target, ``null`` a passive crease. A file without the key folds its M/V
+  creases to ∓180° (Origami Simulator's convention; ``Reading(mv_without_angle=
+  "passive")`` keeps them passive; :mod:`.conventions`).
 * ``frame_unit`` — every length (coordinates, widths, thickness) is converted
   to mm: ``unit`` (or absent) and ``mm`` ×1, ``cm`` ×10, ``m`` ×1000,
   ``in`` ×25.4, ``pt`` ×25.4/72, ``um`` ×1e-3, ``nm`` ×1e-6.
@@ -63,6 +66,7 @@ from ..errors import PatternError
 from ..hinges import HINGE_MODELS
 from ..pattern import DEFAULT_MAX_ANGLE_DEG, CreasePattern
 from ..planar import derive_face_loops, has_repeats, loop_starts, next_in_loop
+from .conventions import Reading, assigned_angles, into_plane, note, trust_signs
 
 #: Largest input file read, bytes (256 MiB).
 MAX_FILE_BYTES = 256 * 1024 * 1024
@@ -116,24 +120,26 @@ class FoldFile:
 
 
 # ------------------------------------------------------------------- reading
-def read_fold(path) -> CreasePattern:
-    """Read the crease pattern of a FOLD file (lengths in mm, angles in degrees).
+def read_fold(path, reading: Reading | None = None) -> CreasePattern:
+    """Read the crease pattern of a FOLD file (lengths in mm, angles in degrees;
+    ``reading``: the conventions, :class:`foldcore.io.conventions.Reading`).
 
     Raises
     ------
     PatternError
         Unreadable, too large, not JSON, or not a valid crease pattern.
     """
-    return read_fold_file(path).pattern
+    return read_fold_file(path, reading).pattern
 
 
-def read_fold_file(path) -> FoldFile:
+def read_fold_file(path, reading: Reading | None = None) -> FoldFile:
     """Read a FOLD file: its crease pattern and ``foldcore:thickness`` (mm)."""
     source = os.fspath(path)
-    return parse_fold(read_bytes(source), source)
+    return parse_fold(read_bytes(source), source, reading)
 
 
-def parse_fold(data: bytes, source: str = "<fold>") -> FoldFile:
+def parse_fold(data: bytes, source: str = "<fold>",
+               reading: Reading | None = None) -> FoldFile:
     """A FOLD file's contents (UTF-8 JSON bytes) as a :class:`FoldFile`.
 
     Parameters
@@ -142,8 +148,10 @@ def parse_fold(data: bytes, source: str = "<fold>") -> FoldFile:
         The file's bytes.
     source : str
         Name used in error messages (the file name).
+    reading : Reading, optional
+        Conventions and scaling (default: Origami Simulator's, :mod:`.conventions`).
     """
-    return fold_file_from_dict(_parse_json(data, source), source)
+    return fold_file_from_dict(_parse_json(data, source), source, reading)
 
 
 def pattern_from_fold_dict(d, source: str = "<fold>") -> CreasePattern:
@@ -159,28 +167,33 @@ def pattern_from_fold_dict(d, source: str = "<fold>") -> CreasePattern:
     return fold_file_from_dict(d, source).pattern
 
 
-def fold_file_from_dict(d, source: str = "<fold>") -> FoldFile:
+def fold_file_from_dict(d, source: str = "<fold>", reading: Reading | None = None) -> FoldFile:
     """Like :func:`pattern_from_fold_dict`, also returning thickness and unit."""
+    reading = Reading() if reading is None else reading
     if not isinstance(d, dict):
         _fail(source, f"the top level must be a JSON object, got {type(d).__name__}")
     unit, scale = _unit_scale(d, source)
-    vertices = _coords(d, scale, source)
+    rows = _crease_pattern_coords(d, source)
+    faces = _faces(d, len(rows), source)
+    vertices = _coords(rows, scale, source, faces)
+    factor = reading.factor(_extent(vertices))
+    if factor != 1.0:
+        vertices, scale = np.asarray(vertices, dtype=np.float64) * factor, scale * factor
     edges = _edges(d, len(vertices), source)
     n = len(edges)
-    key = TARGET_KEY if d.get(TARGET_KEY) is not None else "edges_foldAngle"
+    assignments = _assignments(d, vertices, edges, source)
     widths = _per_edge(d, WIDTH_KEY, n, source)
     max_angles = _per_edge(d, MAX_ANGLE_KEY, n, source)
     args = dict(
-        vertices=vertices, edges=edges,
-        assignments=_assignments(d, vertices, edges, source),
-        fold_angles=_per_edge(d, key, n, source),
+        vertices=vertices, edges=edges, assignments=assignments,
+        fold_angles=_fold_angles(d, assignments, source, reading, max_angles),
         widths=None if widths is None else [
             None if w is None else _scaled(w, scale, f"{WIDTH_KEY}[{e}] (edge {e})", source,
                                            vertices=vertices)
             for e, w in enumerate(widths)],
         max_angles=None if max_angles is None else
         [DEFAULT_MAX_ANGLE_DEG if m is None else m for m in max_angles],
-        faces=_faces(d, len(vertices), source), source=source)
+        faces=faces, source=source)
     pattern = _build(args)
     return FoldFile(pattern, _thickness(d, scale, source, vertices), unit,
                     _stiffness(d, n, args["faces"], source), _hinge_models(d, n, source))
@@ -270,18 +283,52 @@ def _unit_scale(d: dict, source: str) -> tuple[str, float]:
     return unit, UNIT_MM[unit]
 
 
-def _coords(d: dict, scale: float, source: str):
+def _crease_pattern_coords(d: dict, source: str) -> list:
+    """The rows of the crease pattern's coordinates: ``vertices_coords``, or a folded
+    form's ``vertices_flatUnfoldCoords`` (said)."""
+    classes = d.get("frame_classes")
+    folded = isinstance(classes, ARRAY) and "foldedForm" in classes
+    if d.get("vertices_flatUnfoldCoords") is not None and folded:
+        rows = _required_list(d, "vertices_flatUnfoldCoords", source)
+        note(source, "a folded form: its crease pattern read from vertices_flatUnfoldCoords")
+        return rows
+    if folded:  # Origami Simulator labels its flat exports so: flat is read as the pattern
+        note(source, "labelled a folded form (frame_classes: foldedForm) without "
+                     "vertices_flatUnfoldCoords: its coordinates are read as the crease "
+                     "pattern, which must be flat and without overlaps")
+    return _required_list(d, "vertices_coords", source)
+
+
+def _extent(vertices) -> float:
+    v = np.asarray(vertices, dtype=np.float64).reshape(-1, 2)
+    return float(np.ptp(v, axis=0).max()) if len(v) else 0.0
+
+
+def _fold_angles(d: dict, assignments, source: str, reading: Reading,
+                 max_angles=None) -> list | None:
+    """Target angles per edge (degrees, None = passive): ``foldcore:edges_targetAngle``
+    (a result file), else ``edges_foldAngle`` (or FOLD 1.0's ``edges_foldAngles``),
+    else from the assignments (:func:`.conventions.assigned_angles`)."""
+    for key in (TARGET_KEY, "edges_foldAngle", "edges_foldAngles"):
+        if d.get(key) is not None:
+            angles = _per_edge(d, key, len(assignments), source)
+            return trust_signs(angles, assignments, source) if reading.trust_assignment \
+                else angles
+    return assigned_angles(assignments, source, reading, max_angles)
+
+
+def _coords(rows: list, scale: float, source: str, faces=None):
     """(V, 2) vertex coordinates in mm (``[]`` for none), checked at once when the rows
-    are plain [x, y] or [x, y, z] lists; from the first suspect row on, row by row."""
-    rows = _required_list(d, "vertices_coords", source)
+    are plain [x, y] or [x, y, z] lists; from the first suspect row on, row by row. A
+    sheet in 3D off the z = 0 plane is rotated into it (:func:`.conventions.into_plane`)."""
     xy = _number_table(rows, (2, 3))
     if xy is None:
         return _coords_by_row(rows, scale, source, 0)
     with np.errstate(over="ignore", invalid="ignore"):
         mm = xy[:, :2] * scale
     bad = ~np.isfinite(xy).all(axis=1) | ~np.isfinite(mm).all(axis=1)
-    if xy.shape[1] == 3:
-        bad |= xy[:, 2] != 0
+    if xy.shape[1] == 3 and not bad.any() and (xy[:, 2] != 0).any():
+        return into_plane(xy * scale, faces, source)
     if not bad.any():
         return mm
     first = int(np.argmax(bad))
@@ -297,8 +344,8 @@ def _coords_by_row(rows, scale: float, source: str, start: int):
             _fail(source, f"vertices_coords[{i}] (vertex {i}) must be 2 or 3 finite "
                           f"numbers, got {_short(row)}")
         if len(xyz) == 3 and xyz[2] != 0:
-            _fail(source, f"vertex {i} has z = {xyz[2]:g}; the crease pattern "
-                          "(frame 0) must be flat (z = 0)")
+            _fail(source, f"vertex {i} has z = {xyz[2]:g} where other rows are 2D; "
+                          "give every vertex 2 coordinates, or 3 on one plane")
         out.append([_scaled(x, scale, f"vertices_coords[{i}] (vertex {i})", source)
                     for x in xyz[:2]])
     return out if start == 0 else np.array(out, dtype=np.float64).reshape(-1, 2)
@@ -565,7 +612,10 @@ def _scaled(value: float, scale: float, what: str, source: str, vertices=None) -
 def _build(args: dict) -> CreasePattern:
     try:
         return CreasePattern(**args)
-    except PatternError:
+    except PatternError as exc:
+        if "contradicts assignment" in str(exc):  # a file writing magnitudes only
+            raise PatternError(f"{exc}; --trust-assignment (Reading(trust_assignment="
+                               "True)) gives angles their assignment's sign") from None
         raise
     except Exception as exc:  # last resort: never a raw traceback for user input
         raise PatternError(f"{args['source']}: unexpected malformed pattern "

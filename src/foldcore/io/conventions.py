@@ -1,0 +1,188 @@
+"""How crease patterns from the origami ecosystem are read: Origami Simulator's
+conventions, and the options that turn them off.
+
+Most public FOLD and SVG files are made for Origami Simulator (Ghassaei et
+al. 2018), so foldcore reads them as it does (its ``js/importer.js`` and
+``js/pattern.js``):
+
+* **An M/V crease without an angle folds.** A FOLD file with no
+  ``edges_foldAngle`` (and no ``foldcore:edges_targetAngle``) gets target
+  angles from its assignments: ``M`` −180°, ``V`` +180°, ``F`` 0°, others
+  passive; the fold percent scales them. :attr:`Reading.mv_without_angle`
+  ``"passive"`` keeps foldcore's older meaning (every crease passive). Where
+  the key is present, a ``null`` entry stays passive: the file said so.
+* **A flat sheet in any plane** is rotated into z = 0 (Origami Simulator
+  exports lie in its xz-plane). The normal is the one about which the faces
+  run counter-clockwise (right-hand rule; without faces, the normal whose
+  first non-zero component of (z, −y, x) is positive), so the faces' top
+  side — the side valleys fold towards — stays on top.
+* **A folded form** (``frame_classes`` ``foldedForm``, or coordinates off a
+  plane) is read through its ``vertices_flatUnfoldCoords``; without them it is
+  refused with a message saying which keys would do.
+* **Lengths**: ``frame_unit`` as before (a unit-square file is 1 mm wide);
+  :attr:`Reading.scale` multiplies every length of the file, or
+  :attr:`Reading.size` sets the sheet's larger extent in mm.
+* **Angles against their assignment** are refused; :attr:`Reading.
+  trust_assignment` gives them the assignment's sign instead (said once).
+
+Every change is said once per file as a :class:`foldcore.errors.PatternWarning`
+(the command line prints one line per kind).
+"""
+from __future__ import annotations
+
+import math
+import warnings
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import PatternError, PatternWarning
+
+#: Out-of-plane spread, relative to the sheet's extent, below which a 3D sheet is flat
+#: (Origami Simulator's exports: coordinates printed to 6–17 digits).
+PLANE_TOLERANCE = 1e-6
+#: Target angle, degrees, of an assigned crease without one (Origami Simulator's).
+ASSIGNED_ANGLE = {"M": -180.0, "V": 180.0, "F": 0.0}
+
+
+@dataclass(frozen=True)
+class Reading:
+    """Options of reading a crease-pattern file (module docstring).
+
+    Attributes
+    ----------
+    mv_without_angle : {"fold", "passive"}
+        What an M/V crease of a file without angles does: fold to ±180° × the
+        fold percent (Origami Simulator's convention, default) or stay passive.
+    trust_assignment : bool
+        An angle whose sign contradicts its M/V assignment takes the
+        assignment's sign (default False: refused, naming the edge).
+    scale : float or None
+        Every length of the file (after ``frame_unit``) × this (dimensionless).
+    size : float or None
+        Alternatively, the sheet's larger extent in mm (the file's lengths are
+        scaled to it).
+    """
+
+    mv_without_angle: str = "fold"
+    trust_assignment: bool = False
+    scale: float | None = None
+    size: float | None = None
+
+    def __post_init__(self):
+        if self.mv_without_angle not in ("fold", "passive"):
+            raise ValueError(f"mv_without_angle must be 'fold' or 'passive', "
+                             f"got {self.mv_without_angle!r}")
+        if self.scale is not None and self.size is not None:
+            raise ValueError("give scale or size, not both")
+        for name in ("scale", "size"):
+            value = getattr(self, name)
+            if value is not None and not (value > 0 and math.isfinite(value)):
+                raise ValueError(f"{name} must be a positive finite number, got {value!r}")
+
+    def factor(self, extent_mm: float) -> float:
+        """The factor every length is multiplied by, for a sheet ``extent_mm`` wide."""
+        if self.size is not None:
+            return self.size / extent_mm if extent_mm > 0 else 1.0
+        return 1.0 if self.scale is None else self.scale
+
+
+def note(source: str, message: str) -> None:
+    """Say once that the file was read with a convention the user should know of."""
+    warnings.warn(f"{source}: {message}", PatternWarning, stacklevel=3)
+
+
+def assigned_angles(assignments, source: str, reading: Reading,
+                    max_angles=None) -> list | None:
+    """Target angles (degrees, None = passive) of a file without angles, or None to
+    leave every crease passive (``max_angles``: per edge, degrees, None = 180; an
+    M/V crease folds to its own largest angle where that is below 180°)."""
+    if reading.mv_without_angle == "passive":
+        return None
+    kinds = np.asarray(assignments, dtype=object)
+    mv = int(np.count_nonzero((kinds == "M") | (kinds == "V")))
+    if not mv:
+        return None
+    note(source, f"no edges_foldAngle: {mv} M/V creases fold to ±180° × the fold percent "
+                 "(Origami Simulator's convention; --mv-passive keeps them passive)")
+    limits = [None] * len(assignments) if max_angles is None else max_angles
+    return [None if a not in ASSIGNED_ANGLE else
+            ASSIGNED_ANGLE[a] * min(180.0, 180.0 if m is None else m) / 180.0
+            for a, m in zip(assignments, limits)]
+
+
+def trust_signs(angles: list, assignments, source: str) -> list:
+    """``angles`` with every sign that contradicts its M/V assignment flipped (said)."""
+    flipped = 0
+    out = list(angles)
+    for e, (angle, kind) in enumerate(zip(angles, assignments)):
+        if angle is not None and (kind == "M" and angle > 0 or kind == "V" and angle < 0):
+            out[e] = -angle
+            flipped += 1
+    if flipped:
+        note(source, f"{flipped} fold angles took their assignment's sign "
+                     "(--trust-assignment)")
+    return out
+
+
+def into_plane(xyz: np.ndarray, faces, source: str) -> np.ndarray:
+    """(V, 2) coordinates of a flat sheet given in 3D in any plane, rotated into z = 0.
+
+    Parameters
+    ----------
+    xyz : (V, 3) float
+        Vertex coordinates, mm.
+    faces : list of lists of int or None
+        ``faces_vertices``, which fix the normal (module docstring).
+
+    Raises
+    ------
+    PatternError
+        The vertices are not on one plane (a folded form).
+    """
+    centre = xyz.mean(axis=0)
+    _, _, rows = np.linalg.svd(xyz - centre, full_matrices=False)
+    extent = float(np.ptp(xyz, axis=0).max())
+    spread = float(np.abs((xyz - centre) @ rows[2]).max())
+    if not spread <= PLANE_TOLERANCE * extent:
+        raise PatternError(
+            f"{source}: the vertices are not on one plane (off it by up to {spread:g}, "
+            f"{spread / extent:.1e} of the sheet): a folded form; foldcore reads the crease "
+            "pattern from vertices_flatUnfoldCoords or a 2D key frame")
+    normal = _oriented_normal(xyz, faces, rows[2])
+    rotated = xyz @ _rotation_onto_z(normal).T  # z is now the plane's offset: dropped
+    angle = math.degrees(math.acos(max(-1.0, min(1.0, float(normal[2])))))
+    note(source, f"a flat sheet off the z = 0 plane (normal {_vector(normal)}): rotated "
+                 f"by {angle:.4g}° into it, faces' top side up")
+    return rotated[:, :2]
+
+
+def _oriented_normal(xyz: np.ndarray, faces, normal: np.ndarray) -> np.ndarray:
+    """``normal`` or its opposite: the one the faces run counter-clockwise about."""
+    if faces:
+        area = np.zeros(3)
+        for face in faces:
+            p = xyz[np.asarray(face, dtype=np.int64)]
+            area += np.cross(p, np.roll(p, -1, axis=0)).sum(axis=0)
+        if float(area @ normal) != 0.0:
+            return normal if float(area @ normal) > 0 else -normal
+    for component, sign in ((2, 1.0), (1, -1.0), (0, 1.0)):
+        if abs(normal[component]) > PLANE_TOLERANCE:
+            return normal if sign * normal[component] > 0 else -normal
+    return normal
+
+
+def _rotation_onto_z(n: np.ndarray) -> np.ndarray:
+    """(3, 3) rotation taking the unit vector ``n`` to +z (about n × z; a half-turn
+    about x for n = −z)."""
+    z = np.array([0.0, 0.0, 1.0])
+    axis, cos = np.cross(n, z), float(n @ z)
+    if np.linalg.norm(axis) < 1e-15:
+        return np.eye(3) if cos > 0 else np.diag([1.0, -1.0, -1.0])
+    k = np.array([[0.0, -axis[2], axis[1]], [axis[2], 0.0, -axis[0]],
+                  [-axis[1], axis[0], 0.0]])
+    return np.eye(3) + k + k @ k / (1.0 + cos)
+
+
+def _vector(v: np.ndarray) -> str:
+    return "(" + ", ".join(f"{x:.3g}" if abs(x) > 1e-12 else "0" for x in v) + ")"

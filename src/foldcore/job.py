@@ -1,0 +1,186 @@
+"""One fold from a file to its outputs — what ``foldcore simulate`` does, as a call.
+
+>>> result = foldcore.simulate("crane.fold", thickness=0.5, sheet_size=200,
+...                            fold_percent=30, output="crane-30.fold")  # doctest: +SKIP
+
+Reads the pattern (:mod:`foldcore.io`, Origami Simulator's conventions:
+:mod:`foldcore.io.conventions`), checks every output path before any work
+(:mod:`foldcore.destinations`), thickens, runs the simulation at the fold
+percent (or along an animation's sweep) and writes the outputs all or nothing
+(:mod:`foldcore.outputs`). Warnings the run calls for — nothing driven, or
+converged with its targets missed — are :class:`foldcore.errors.RunWarning`.
+Every option is the command line's, with the same defaults and units (mm,
+degrees); the command line adds only its messages and exit codes.
+"""
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass
+
+from .actuation import BRANCH_FLOOR_DEG, DEFAULT_ACTUATION
+from .strategies import DEFAULT_SOLVER
+
+
+@dataclass(frozen=True)
+class Loaded:
+    """A pattern file read: the pattern and the file-level values thicken() takes."""
+
+    pattern: object  # CreasePattern
+    thickness: float | None  # mm, the file's foldcore:thickness
+    stiffness: dict | None
+    hinge: list | None
+
+
+@dataclass
+class Fold:
+    """A finished fold: what the command line reports from."""
+
+    pattern: object  # CreasePattern
+    mesh: object  # ThickMesh
+    simulation: object  # Simulation
+    result: object  # Result
+    settings: dict  # recorded in the report
+    summary: str  # one line: verdict, iterations, time, miss
+
+
+def load(path, *, hinges=None, reading=None) -> Loaded:
+    """Read a FOLD file, or an OBJ/STL mesh with its hinge file, checking the ranges
+    arithmetic survives (:mod:`foldcore.limits`)."""
+    import os
+
+    from .errors import PatternError
+    from .io import Reading, read, read_fold_file
+
+    source = os.fspath(path)
+    reading = Reading() if reading is None else reading
+    if source.lower().endswith(".fold"):
+        if hinges:
+            raise PatternError(f"{source}: --hinges only goes with an OBJ/STL pattern")
+        fold = read_fold_file(source, reading)
+        return Loaded(fold.pattern, fold.thickness, fold.stiffness, fold.hinge)
+    if source.lower().endswith(".svg"):
+        if hinges:
+            raise PatternError(f"{source}: --hinges only goes with an OBJ/STL pattern")
+        return Loaded(read(source, reading=reading), None, None, None)
+    if reading.scale is not None or reading.size is not None:
+        raise PatternError(f"{source}: --scale and --sheet-size apply to FOLD and SVG "
+                           "patterns; an OBJ/STL mesh is read in mm")
+    return Loaded(read(source, hinges=hinges), None, None, None)
+
+
+def simulate(path, *, thickness: float | None = None, hinge_width: float | None = None,
+             subdivisions="auto", fold_percent: float = 100.0, solver: str = DEFAULT_SOLVER,
+             tolerance: float = 1e-8, max_iterations: int = 10_000, hinge: str | None = None,
+             actuation: str = DEFAULT_ACTUATION, branch_floor: float = BRANCH_FLOOR_DEG,
+             hinges=None, mv_passive: bool = False, trust_assignment: bool = False,
+             scale: float | None = None, sheet_size: float | None = None,
+             output=None, report=None, render=None, animate=None, frames: int = 20,
+             fps: float = 10.0):
+    """Fold the pattern file at ``path`` and write the outputs asked for; the Result.
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        ``.fold``, or ``.obj``/``.stl`` with a hinge file (``hinges``, default
+        PATH.hinges).
+    thickness : float, optional
+        Sheet thickness H, mm (default: the file's ``foldcore:thickness``).
+    hinge_width : float, optional
+        Hinge width W of every crease, mm (default: the file's, else Eq. 7).
+    subdivisions : int or "auto"
+    fold_percent : float
+        Every target angle × this / 100, in [−100, 100].
+    solver, tolerance, max_iterations, hinge, actuation, branch_floor
+        As :class:`foldcore.Simulation` and its ``run`` (``branch_floor``: degrees).
+    mv_passive, trust_assignment, scale, sheet_size
+        How the file is read (:class:`foldcore.io.Reading`; ``sheet_size``: mm).
+    output, report, render, animate : path, optional
+        Result FOLD, JSON report, PNG render, GIF/MP4 of the sweep from 0 to
+        ``fold_percent`` in ``frames`` frames at ``fps`` (the last frame's run is
+        the result).
+
+    Returns
+    -------
+    Result
+    """
+    return fold(path, **{k: v for k, v in locals().items() if k != "path"}).result
+
+
+def fold(path, **options) -> Fold:
+    """:func:`simulate`, keeping what the command line reports from (a :class:`Fold`)."""
+    import os
+
+    from .destinations import check_destinations
+    from .errors import RunWarning, SimulationError
+    from .io import Reading
+    from .limits import check_inputs
+    from .outputs import run_summary, write_result
+    from .simulation import Simulation
+    from .thickening import thicken
+
+    o = _with_defaults(options)
+    source = os.fspath(path)
+    if o["max_iterations"] < 1:
+        raise SimulationError(f"--max-iterations must be ≥ 1, got {o['max_iterations']}")
+    reading = Reading(mv_without_angle="passive" if o["mv_passive"] else "fold",
+                      trust_assignment=o["trust_assignment"], scale=o["scale"],
+                      size=o["sheet_size"])
+    loaded = load(source, hinges=o["hinges"], reading=reading)
+    check_inputs(loaded.pattern, o["thickness"], o["hinge_width"], loaded.stiffness)
+    thickness = o["thickness"] or loaded.thickness
+    if thickness is None:
+        raise SimulationError(f"{source}: no thickness: pass --thickness H (mm) "
+                              "or set foldcore:thickness in the file")
+    check_destinations({"-o": o["output"], "--report": o["report"], "--render": o["render"],
+                        "--animate": o["animate"]}, inputs=(source, o["hinges"]),
+                       suffixes={"--render": (".png",)})
+    if o["animate"]:
+        from .animate import check_output
+        check_output(o["animate"])          # a missing encoder fails before any work
+    mesh = thicken(loaded.pattern, thickness, o["hinge_width"], o["subdivisions"],
+                   hinge=o["hinge"] or loaded.hinge, stiffness=loaded.stiffness)
+    sim = Simulation(mesh, loaded.pattern, solver=o["solver"], actuation=o["actuation"],
+                     branch_floor_deg=o["branch_floor"])
+    if o["animate"]:
+        result = _animate(sim, o)
+    else:
+        sim.set_fold_percent(o["fold_percent"])
+        result = sim.run(tolerance=o["tolerance"], max_iterations=o["max_iterations"])
+    summary, said = run_summary(result, loaded.pattern, source, o["fold_percent"])
+    for text in said:
+        warnings.warn(text, RunWarning, stacklevel=3)
+    settings = {"pattern": source, **{k: o[k] for k in ("fold_percent", "solver", "tolerance",
+                                                        "max_iterations", "subdivisions")}}
+    settings.update(thickness_mm=thickness, hinge=sorted(set(mesh.hinge_model) - {""}),
+                    actuation=o["actuation"], branch_floor_deg=o["branch_floor"],
+                    backend=sim.system.factor.backend)
+    write_result(result, loaded.pattern, mesh, thickness, settings, fold=o["output"],
+                 report=o["report"], png=o["render"])
+    return Fold(loaded.pattern, mesh, sim, result, settings, summary)
+
+
+def _with_defaults(options: dict) -> dict:
+    """``options`` over :func:`simulate`'s defaults; an unknown name is a TypeError."""
+    import inspect
+
+    defaults = {name: p.default for name, p in inspect.signature(simulate).parameters.items()
+                if p.kind is p.KEYWORD_ONLY}
+    unknown = set(options) - set(defaults)
+    if unknown:
+        raise TypeError(f"simulate() got unexpected options {sorted(unknown)}")
+    return {**defaults, **options}
+
+
+def _animate(sim, o: dict):
+    """Fold ``sim`` from 0 to the fold percent in ``frames`` steps, write the movie;
+    the last frame's Result (a RunWarning counts unconverged intermediate frames)."""
+    from .animate import animate, percent_schedule
+    from .errors import RunWarning
+
+    movie = animate(sim, percent_schedule(o["frames"], o["fold_percent"]), o["animate"],
+                    fps=o["fps"], tolerance=o["tolerance"], max_iterations=o["max_iterations"])
+    unconverged = sum(not r.converged for r in movie.results[:-1])
+    if unconverged:
+        warnings.warn(f"{unconverged} of {len(movie.results) - 1} intermediate animation "
+                      "frames not converged", RunWarning, stacklevel=3)
+    return movie.results[-1]

@@ -1,0 +1,148 @@
+"""Reading files made for Origami Simulator (issue 19, item 1): M/V without angles,
+sheets in any plane, folded forms, scaling, and angles against their assignment."""
+from __future__ import annotations
+
+import json
+import warnings
+
+import numpy as np
+import pytest
+
+from foldcore.errors import PatternError, PatternWarning
+from foldcore.io import Reading, pattern_from_fold_dict
+from foldcore.io.conventions import into_plane
+from foldcore.io.fold import fold_file_from_dict
+from foldcore.measure import on_assigned_side
+
+from test_io import fold_json, four_squares, two_squares
+
+
+def without_angles(pattern) -> dict:
+    d = fold_json(pattern)
+    del d["edges_foldAngle"]
+    return d
+
+
+def read_said(d, reading=None):
+    """(pattern, messages of the PatternWarnings said while reading)."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        pattern = fold_file_from_dict(d, "f.fold", reading).pattern
+    return pattern, [str(w.message) for w in caught if w.category is PatternWarning]
+
+
+def test_mv_without_angles_fold_to_180_as_in_origami_simulator():
+    d = without_angles(four_squares())  # creases 8..11: V, V, V, M
+    del d["foldcore:edges_maxAngle"]
+    pattern, said = read_said(d)
+    np.testing.assert_array_equal(pattern.fold_angles[8:], [180.0, 180.0, 180.0, -180.0])
+    assert np.isnan(pattern.fold_angles[:8]).all()  # boundary
+    (message,) = said
+    assert "f.fold" in message and "4 M/V creases" in message and "--mv-passive" in message
+
+
+def test_an_assigned_crease_folds_to_its_own_largest_angle_below_180():
+    d = without_angles(four_squares())  # max angles 90, 180, 120, 60 on creases 8..11
+    np.testing.assert_array_equal(read_said(d)[0].fold_angles[8:], [90.0, 180.0, 120.0, -60.0])
+
+
+def test_mv_passive_keeps_the_old_meaning_and_an_explicit_null_stays_passive():
+    pattern, said = read_said(without_angles(four_squares()), Reading(mv_without_angle="passive"))
+    assert np.isnan(pattern.fold_angles).all() and not said
+    d = fold_json(four_squares())  # the key present, every entry null: the file said so
+    d["edges_foldAngle"] = [None] * len(d["edges_vertices"])
+    pattern, said = read_said(d)
+    assert np.isnan(pattern.fold_angles).all() and not said
+
+
+def test_fold_1_0_plural_key_is_read():
+    d = without_angles(two_squares())
+    d["edges_foldAngles"] = [0] * 6 + [45]
+    assert read_said(d)[0].fold_angles[6] == 45.0
+
+
+def as_origami_simulator_writes(d: dict) -> dict:
+    """Origami Simulator's exports: (x, y) → (x, 0, y), the sheet in the xz-plane."""
+    d = dict(d)
+    d["vertices_coords"] = [[x, 0.0, y] for x, y in d["vertices_coords"]]
+    d["frame_classes"] = ["foldedForm"]
+    return d
+
+
+@pytest.mark.parametrize("make", [two_squares, four_squares])
+def test_a_sheet_in_the_xz_plane_reads_as_the_flat_pattern(make):
+    """Rotated back exactly (a quarter turn about x), faces' top side up, so every
+    crease keeps its sense; said once per change."""
+    flat = make()
+    pattern, said = read_said(as_origami_simulator_writes(fold_json(flat)))
+    np.testing.assert_allclose(pattern.vertices, flat.vertices, atol=1e-12)
+    np.testing.assert_array_equal(pattern.assignments, flat.assignments)
+    np.testing.assert_array_equal(pattern.fold_angles, flat.fold_angles)
+    assert any("rotated by 90°" in m for m in said)
+    assert any("folded form" in m for m in said)
+
+
+def test_a_tilted_plane_keeps_lengths_and_the_faces_orientation():
+    flat = four_squares()
+    rng = np.random.default_rng(19)
+    q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+    q *= np.sign(np.linalg.det(q))  # a rotation
+    xyz = np.column_stack([flat.vertices, np.zeros(len(flat.vertices))]) @ q.T + [5, -3, 2]
+    xy = into_plane(xyz, [f.tolist() for f in flat.faces], "t.fold")
+    def distances(v):
+        return np.linalg.norm(v[:, None] - v[None], axis=2)
+    np.testing.assert_allclose(distances(xy), distances(flat.vertices), atol=1e-9)
+    def area(v, f):  # shoelace: > 0 counter-clockwise
+        p, q = v[f], np.roll(v[f], -1, axis=0)
+        return 0.5 * float((p[:, 0] * q[:, 1] - p[:, 1] * q[:, 0]).sum())
+    assert all(area(xy, f) > 0 for f in flat.faces)  # still counter-clockwise: same top
+
+
+def test_a_folded_form_reads_its_flat_unfold_coordinates():
+    cp = json.load(open("tests/data/real/diagonal-cp.fold"))
+    folded = json.load(open("tests/data/real/diagonal-folded.fold"))
+    a, _ = read_said(cp)
+    b, said = read_said(folded)
+    np.testing.assert_allclose(b.vertices, a.vertices)
+    assert any("vertices_flatUnfoldCoords" in m for m in said)
+
+
+def test_a_folded_form_without_flat_coordinates_is_refused_saying_what_would_do():
+    with pytest.raises(PatternError) as info:
+        read_said(json.load(open("tests/data/real/simple.fold")))
+    message = str(info.value)
+    assert "f.fold" in message and "not on one plane" in message
+    assert "vertices_flatUnfoldCoords" in message
+
+
+def test_scale_and_sheet_size_scale_every_length():
+    d = fold_json(two_squares(), **{"foldcore:thickness": 0.1})
+    scaled = fold_file_from_dict(d, "f", Reading(scale=50.0))
+    np.testing.assert_allclose(scaled.pattern.vertices, 50.0 * two_squares().vertices)
+    assert scaled.pattern.widths[6] == pytest.approx(50.0 * 2.5)
+    assert scaled.thickness == pytest.approx(5.0)
+    sized = fold_file_from_dict(d, "f", Reading(size=300.0))  # extent 2 → 300 mm
+    assert np.ptp(sized.pattern.vertices, axis=0).max() == pytest.approx(300.0)
+    assert sized.thickness == pytest.approx(15.0)
+    with pytest.raises(ValueError):
+        Reading(scale=2.0, size=3.0)
+
+
+def test_an_angle_against_its_assignment_is_refused_or_trusted():
+    d = fold_json(two_squares())
+    d["edges_foldAngle"][6] = -90.0  # a V crease at -90: Rabbit Ear's kite writes M +90
+    with pytest.raises(PatternError) as info:
+        pattern_from_fold_dict(d, "k.fold")
+    assert "edge 6" in str(info.value) and "--trust-assignment" in str(info.value)
+    pattern, said = read_said(d, Reading(trust_assignment=True))
+    assert pattern.fold_angles[6] == 90.0
+    assert any("1 fold angles took their assignment's sign" in m for m in said)
+
+
+def test_achieved_angles_keep_the_assignments_sign_past_flat():
+    """A mountain 0.54° past flat is −180.54°, not +179.46° (which contradicted 'M'
+    and was painted as a valley); U creases are left as measured."""
+    kinds = np.array(list("MVUMV"))
+    measured = np.array([179.46, -179.41, 179.46, -30.0, 30.0])
+    np.testing.assert_allclose(on_assigned_side(measured, kinds),
+                               [-180.54, 180.59, 179.46, -30.0, 30.0])
