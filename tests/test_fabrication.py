@@ -179,9 +179,10 @@ def test_cli_export_writes_svg_dxf_stl_read_back_independently(result_fold, tmp_
     svg, dxf, stl = (tmp_path / f"sheet.{s}" for s in ("svg", "dxf", "stl"))
     assert main(["export", str(result_fold), "--svg", str(svg), "--dxf", str(dxf),
                  "--stl", str(stl)]) == 0
-    _, mesh, result = scene("d4")
-    expected = sheet_outlines(mesh)
+    pattern, mesh, result = scene("d4")
+    expected = sheet_outlines(mesh, pattern)
     from_svg, from_dxf = _svg_polygons(svg), _dxf_polylines(dxf)
+    assert set(from_svg) == set(from_dxf) == set(expected)
     for layer, loops in expected.items():
         assert len(from_svg[layer]) == len(from_dxf[layer]) == len(loops), layer
         for want, got_svg, got_dxf in zip(loops, from_svg[layer], from_dxf[layer]):
@@ -193,6 +194,39 @@ def test_cli_export_writes_svg_dxf_stl_read_back_independently(result_fold, tmp_
     assert solid.is_watertight
     assert solid.bounds == pytest.approx(np.array([result.positions.min(axis=0),
                                                    result.positions.max(axis=0)]), abs=1e-5)
+
+
+def test_hinges_are_on_mountain_and_valley_layers_in_origami_simulators_colours(
+        result_fold, tmp_path):
+    """Issue 19: red was 'cut here' in foldcore's SVG and 'mountain' in Origami
+    Simulator's; M and V strips shared one layer; strokes were 0.05 mm at any size."""
+    import xml.etree.ElementTree as ET
+
+    pattern, mesh, _ = scene("d4")
+    outlines = sheet_outlines(mesh, pattern)
+    kinds = {str(pattern.assignments[e]) for e in mesh.strips_of_crease}
+    assert {k for k in kinds if k in "MV"} == {"M", "V"}
+    counts = {k: sum(pattern.assignments[e] == k for e in mesh.strips_of_crease) for k in kinds}
+    assert len(outlines["HINGE_M"]) == counts["M"] and len(outlines["HINGE_V"]) == counts["V"]
+    assert len(sheet_outlines(mesh)["HINGE"]) == len(mesh.strips_of_crease)  # no pattern
+    svg = tmp_path / "s.svg"
+    assert main(["export", str(result_fold), "--svg", str(svg)]) == 0
+    root = ET.parse(svg).getroot()
+    groups = {g.get("id"): g for g in root.iter("{http://www.w3.org/2000/svg}g")}
+    colours = {k: g.get("stroke") for k, g in groups.items()}
+    assert colours["cut"] == "#000000" and colours["hinge_m"] == "#ff0000"
+    assert colours["hinge_v"] == "#0000ff"
+    every = np.vstack([p for loops in outlines.values() for p in loops])
+    extent = float(np.ptp(every, axis=0).max())
+    assert float(groups["cut"].get("stroke-width")) == pytest.approx(
+        min(0.1, 1e-3 * extent), rel=1e-5)
+    assert main(["export", str(result_fold), "--svg", str(svg), "--stroke-width", "0.02",
+                 "--margin", "5"]) == 0
+    root = ET.parse(svg).getroot()
+    assert {g.get("stroke-width") for g in root.iter("{http://www.w3.org/2000/svg}g")} \
+        == {"0.02"}
+    width = float(root.get("width").removesuffix("mm"))
+    assert width == pytest.approx(np.ptp(every[:, 0]) + 10.0, abs=1e-5)
 
 
 def test_cli_export_any_subset(result_fold, tmp_path):

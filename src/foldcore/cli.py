@@ -170,7 +170,9 @@ def build_parser() -> argparse.ArgumentParser:
                           "least DEG degrees on their assigned side, then release them "
                           f"(branch selection; 0 turns it off; default {BRANCH_FLOOR_DEG:g})")
     sim.add_argument("-q", "--quiet", action="store_true",
-                     help="no summary line on stderr (warnings and errors are still said)")
+                     help="no progress bar and no summary line on stderr (warnings and "
+                          "errors are still said); the bar shows only on a terminal, "
+                          f"after {PROGRESS_DELAY:g} s")
     sim.add_argument("-o", "--output", help="write the result as FOLD (achieved angles + "
                                             "folded solid in file_frames)")
     sim.add_argument("--report", help="write the JSON report here")
@@ -179,8 +181,12 @@ def build_parser() -> argparse.ArgumentParser:
     sim.add_argument("--animate", metavar="OUT.gif|OUT.mp4",
                      help="also write an animation of the fold from 0 to --fold-percent "
                           "(needs the 'render' extra; MP4 the 'video' extra: imageio-ffmpeg)")
+    sim.add_argument("--series", metavar="OUT.fold",
+                     help="also write the fold from 0 to --fold-percent as one FOLD file, a "
+                          "frame per fold percent (achieved angles and the folded solid)")
     sim.add_argument("--frames", type=_frames, default=20,
-                     help="animation frames, fold percents evenly from 0 (default 20)")
+                     help="frames of --animate / --series, fold percents evenly from 0 "
+                          "(default 20)")
     sim.add_argument("--fps", type=_fps, default=10.0,
                      help="animation frames per second (default 10)")
 
@@ -203,6 +209,11 @@ def build_parser() -> argparse.ArgumentParser:
     exp.add_argument("--svg", help="flat sheet outlines as SVG (mm)")
     exp.add_argument("--dxf", help="flat sheet outlines as DXF (mm; needs the 'export' extra)")
     exp.add_argument("--stl", help="folded solid as binary STL (mm)")
+    exp.add_argument("--stroke-width", type=_positive, metavar="MM",
+                     help="SVG stroke width in mm (default: 1/1000 of the sheet, at most "
+                          "0.1 mm)")
+    exp.add_argument("--margin", type=_non_negative, metavar="MM",
+                     help="SVG margin around the sheet in mm (default: 2%% of the sheet)")
     _add_rebuild_options(exp)
 
     from .scenes import NAMES
@@ -241,9 +252,22 @@ def run_scene(args) -> int:
 def simulate(args) -> int:
     """Run ``foldcore simulate`` (:func:`foldcore.job.fold`); raises FoldcoreError on
     bad input."""
-    from .job import fold
+    from .job import Interrupted, fold
 
-    done = fold(args.pattern, **{name: getattr(args, name) for name in _SIMULATE_OPTIONS})
+    progress = _progress(args)
+    try:
+        done = fold(args.pattern, callback=progress,
+                    **{name: getattr(args, name) for name in _SIMULATE_OPTIONS})
+    except Interrupted as stop:
+        written = ", ".join(f"{k} {v}" for k, v in stop.written.items())
+        print(f"foldcore: interrupted (SIGINT) after {stop.result.iterations} iterations; "
+              + (f"the last iterate was written as a partial result ({written}; marked "
+                 "foldcore:partial)" if written else "no output was asked for"),
+              file=sys.stderr)
+        return EXIT_SIGINT
+    finally:
+        if progress is not None:
+            progress.close()
     result = done.result
     if not result.converged:
         print(f"foldcore: warning: {args.pattern}: not converged after {result.iterations} "
@@ -254,11 +278,50 @@ def simulate(args) -> int:
     return 0
 
 
+class _Progress:
+    """A tqdm bar on stderr for a run: iterations against --max-iterations, the last
+    step relative to the tolerance's limit, and the ETA; shown only once the run
+    has taken PROGRESS_DELAY seconds."""
+
+    def __init__(self, total: int, limit_ratio: float):
+        from tqdm import tqdm
+
+        self._bar = tqdm(total=total, unit="it", delay=PROGRESS_DELAY, file=sys.stderr,
+                         leave=False, dynamic_ncols=True)
+        self._size_limit = limit_ratio
+
+    def __call__(self, sim, moved: float) -> bool:
+        self._bar.update(1)
+        if self._bar.n % 10 == 0:
+            self._bar.set_postfix_str(
+                f"step/limit {moved / (self._size_limit * sim.length_scale):.2g}",
+                refresh=False)
+        return True
+
+    def close(self) -> None:
+        self._bar.close()
+
+
+#: Seconds a run takes before its progress bar appears.
+PROGRESS_DELAY = 2.0
+
+
+def _progress(args):
+    """A progress callback for an interactive run (stderr a terminal, no --quiet, no
+    --animate or --series: their frames have their own runs), else None."""
+    if args.quiet or args.animate or args.series or not sys.stderr.isatty():
+        return None
+    try:
+        return _Progress(args.max_iterations, args.tolerance)
+    except ImportError:  # tqdm is a dependency; a stripped install runs without a bar
+        return None
+
+
 #: ``simulate`` options passed to :func:`foldcore.job.fold` under their own names.
 _SIMULATE_OPTIONS = ("thickness", "hinge_width", "subdivisions", "fold_percent", "solver",
                      "tolerance", "max_iterations", "hinge", "actuation", "branch_floor",
                      "hinges", "mv_passive", "trust_assignment", "scale", "sheet_size",
-                     "output", "report", "render", "animate", "frames", "fps")
+                     "output", "report", "render", "animate", "series", "frames", "fps")
 
 
 def _why(result) -> str:
@@ -313,7 +376,8 @@ def export_result(args) -> int:
     check_destinations({"--svg": args.svg, "--dxf": args.dxf, "--stl": args.stl},
                        inputs=(args.result,))
     export(read_result(args.result, args.hinge_width, args.subdivisions),
-           svg=args.svg, dxf=args.dxf, stl=args.stl)
+           svg=args.svg, dxf=args.dxf, stl=args.stl, stroke_mm=args.stroke_width,
+           margin_mm=args.margin)
     return 0
 
 

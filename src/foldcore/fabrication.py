@@ -5,7 +5,17 @@ Flat sheet (laser cutting), from the ThickMesh footprint ``mesh.points`` (mm):
 * layer ``CUT``: the outline of the whole sheet and the holes left at the
   vertices (the union of every panel and hinge strip), cut through;
 * layer ``PANEL``: the outline of every panel;
-* layer ``HINGE``: the outline of every hinge strip (all its sub-strips).
+* layers ``HINGE_M`` / ``HINGE_V`` / ``HINGE_F``: the outline of every
+  mountain / valley / facet hinge strip (all its sub-strips), and ``HINGE``
+  the others (undriven ``U``, or every strip when no pattern is given).
+
+Colours follow Origami Simulator's crease colours, so a file from one tool
+does not contradict the other: cut outline black (its boundary), mountain red,
+valley blue, facet yellow, other hinges magenta (its undriven), panels grey
+(SVG stroke colours; DXF ACI 7, 1, 5, 2, 6, 8). Stroke width and margin are mm
+options; by default a thousandth of the sheet's larger extent (at most
+``SVG_STROKE_MAX_MM``, a laser cutter's hairline) and 2 % of it, so a
+unit-square sheet is not drawn with strokes 5 % of its width.
 
 Panel and hinge outlines share their common sides (the score lines); which
 layer is cut, scored or only drawn is the laser operator's choice. Every
@@ -45,11 +55,17 @@ from .io.fold import atomic_path as io_atomic_path
 from .io.fold import atomic_write
 from .mesh import SurfaceFaces, surface_polygons  # noqa: F401  (part of this API)
 
-LAYERS = {"CUT": {"dxf_colour": 1, "svg": "#ff0000"},     # red
-          "PANEL": {"dxf_colour": 5, "svg": "#0000ff"},   # blue
-          "HINGE": {"dxf_colour": 3, "svg": "#00a000"}}   # green
-SVG_MARGIN_MM = 1.0
-SVG_STROKE_MM = 0.05
+LAYERS = {"CUT": {"dxf_colour": 7, "svg": "#000000"},      # black: the boundary
+          "PANEL": {"dxf_colour": 8, "svg": "#808080"},    # grey
+          "HINGE_M": {"dxf_colour": 1, "svg": "#ff0000"},  # red: mountain
+          "HINGE_V": {"dxf_colour": 5, "svg": "#0000ff"},  # blue: valley
+          "HINGE_F": {"dxf_colour": 2, "svg": "#ffff00"},  # yellow: facet
+          "HINGE": {"dxf_colour": 6, "svg": "#ff00ff"}}    # magenta: undriven / all
+#: Default SVG margin and stroke width, as shares of the sheet's larger extent, and
+#: the widest default stroke (mm).
+SVG_MARGIN_SHARE = 0.02
+SVG_STROKE_SHARE = 1e-3
+SVG_STROKE_MAX_MM = 0.1
 #: Largest RMS misfit (fraction of the thickness) of a panel's rebuilt footprint
 #: to its folded shape before :func:`read_result` refuses the flat outlines.
 FOOTPRINT_TOLERANCE = 0.05
@@ -207,26 +223,35 @@ def write_stl(path, mesh, positions=None) -> None:
 
 
 # ------------------------------------------------------------------- outlines
-def sheet_outlines(mesh) -> dict:
+def sheet_outlines(mesh, pattern=None) -> dict:
     """Closed outlines of the flat thick sheet, mm, per layer.
+
+    Parameters
+    ----------
+    mesh : ThickMesh
+    pattern : CreasePattern, optional
+        Splits the hinge strips by their crease's assignment (``HINGE_M``,
+        ``HINGE_V``, ``HINGE_F``; the rest stay ``HINGE``).
 
     Returns
     -------
-    dict {"CUT", "PANEL", "HINGE": list of (n, 2) float}
+    dict {"CUT", "PANEL", "HINGE", ...: list of (n, 2) float}
         Each outline once (not repeating its first point), counter-clockwise
         except holes (clockwise), collinear points removed. ``CUT``: the
         sheet's outer boundary and its holes; ``PANEL``: one per panel;
-        ``HINGE``: one per crease strip.
+        ``HINGE*``: one per crease strip (layers without an outline left out).
     """
     import shapely
 
     pts = mesh.points
     panels = mesh.groups[mesh.panel_group]
     panel_loops = [pts[_top(panels, i)] for i in range(len(panels))]
-    hinge_loops = [pts[_strip_outline(mesh, e)] for e in sorted(mesh.strips_of_crease)]
+    creases = sorted(mesh.strips_of_crease)
+    hinge_loops = [pts[_strip_outline(mesh, e)] for e in creases]
     stretch = mesh.groups.get("stretch_hinge")
     if stretch is not None:  # one strip per crease, its top loop is its outline
         hinge_loops += [pts[_top(stretch, i)] for i in range(len(stretch))]
+        creases += [int(e) for e in stretch.source]
     polygons = [shapely.Polygon(p) for p in panel_loops + hinge_loops]
     union = shapely.union_all(polygons)
     cut = []
@@ -237,7 +262,18 @@ def sheet_outlines(mesh) -> dict:
         cut += [np.asarray(ring.coords)[:-1] for ring in poly.interiors]
     scale = float(np.ptp(pts, axis=0).max())
     clean = lambda loops: [_drop_collinear(p, scale) for p in loops]  # noqa: E731
-    return {"CUT": clean(cut), "PANEL": clean(panel_loops), "HINGE": clean(hinge_loops)}
+    out = {"CUT": clean(cut), "PANEL": clean(panel_loops)}
+    layer = [_hinge_layer(pattern, e) for e in creases]
+    for name in ("HINGE_M", "HINGE_V", "HINGE_F", "HINGE"):
+        loops = [p for p, at in zip(hinge_loops, layer) if at == name]
+        if loops or name == "HINGE" and pattern is None:
+            out[name] = clean(loops)
+    return out
+
+
+def _hinge_layer(pattern, edge: int) -> str:
+    kind = "" if pattern is None else str(pattern.assignments[edge])
+    return f"HINGE_{kind}" if kind in ("M", "V", "F") else "HINGE"
 
 
 def _top(group, i) -> np.ndarray:
@@ -274,13 +310,20 @@ def _drop_collinear(xy, scale: float) -> np.ndarray:
 
 
 # ------------------------------------------------------------------- SVG
-def svg_text(outlines: dict, title: str = "foldcore flat sheet") -> str:
+def svg_text(outlines: dict, title: str = "foldcore flat sheet", stroke_mm: float | None = None,
+             margin_mm: float | None = None) -> str:
     """An SVG document (mm) of :func:`sheet_outlines`: one ``<g>`` per layer, ``<polygon>``s.
 
     SVG's y axis points down, so y is written negated (the sheet is not mirrored).
+    ``stroke_mm``/``margin_mm``: stroke width and margin around the sheet, mm
+    (default: shares of the sheet's extent, module docstring).
     """
     every = np.vstack([p for loops in outlines.values() for p in loops])
-    lo, hi = every.min(axis=0) - SVG_MARGIN_MM, every.max(axis=0) + SVG_MARGIN_MM
+    extent = float(np.ptp(every, axis=0).max())
+    stroke = min(SVG_STROKE_MAX_MM, SVG_STROKE_SHARE * extent) if stroke_mm is None \
+        else stroke_mm
+    margin = SVG_MARGIN_SHARE * extent if margin_mm is None else margin_mm
+    lo, hi = every.min(axis=0) - margin, every.max(axis=0) + margin
     w, h = hi - lo
     lines = ['<?xml version="1.0" encoding="UTF-8"?>',
              f'<svg xmlns="http://www.w3.org/2000/svg" version="1.1" width="{_num(w)}mm" '
@@ -289,7 +332,7 @@ def svg_text(outlines: dict, title: str = "foldcore flat sheet") -> str:
     for layer, loops in outlines.items():
         colour = LAYERS.get(layer, {}).get("svg", "#000000")
         lines.append(f'<g id="{layer.lower()}" fill="none" stroke="{colour}" '
-                     f'stroke-width="{SVG_STROKE_MM}">')
+                     f'stroke-width="{_num(stroke)}">')
         for p in loops:
             points = " ".join(f"{_num(x)},{_num(-y)}" for x, y in p)
             lines.append(f'<polygon points="{points}"/>')
@@ -307,14 +350,17 @@ def _xml(text: str) -> str:
     return str(text).replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;")
 
 
-def write_svg(path, mesh) -> None:
+def write_svg(path, mesh, pattern=None, stroke_mm: float | None = None,
+              margin_mm: float | None = None) -> None:
     """Write the flat sheet's outlines as SVG (mm) to ``path`` atomically."""
-    _write_text(path, svg_text(sheet_outlines(mesh)))
+    _write_text(path, svg_text(sheet_outlines(mesh, pattern), stroke_mm=stroke_mm,
+                               margin_mm=margin_mm))
 
 
 # ------------------------------------------------------------------- DXF
 def dxf_text(outlines: dict) -> str:
-    """A DXF (R2010, mm) of :func:`sheet_outlines`: closed LWPOLYLINEs on layers CUT/PANEL/HINGE."""
+    """A DXF (R2010, mm) of :func:`sheet_outlines`: closed LWPOLYLINEs, one DXF layer per
+    outline layer (CUT, PANEL, HINGE_M, HINGE_V, ...)."""
     try:
         import ezdxf
         from ezdxf import units
@@ -334,9 +380,9 @@ def dxf_text(outlines: dict) -> str:
     return stream.getvalue()
 
 
-def write_dxf(path, mesh) -> None:
+def write_dxf(path, mesh, pattern=None) -> None:
     """Write the flat sheet's outlines as DXF (mm) to ``path`` atomically."""
-    _write_text(path, dxf_text(sheet_outlines(mesh)))
+    _write_text(path, dxf_text(sheet_outlines(mesh, pattern)))
 
 
 def _write_text(path, text: str) -> None:
@@ -566,7 +612,8 @@ def _matching_mesh(pattern, thickness, hinge_width, subdivisions, positions, fac
 
 
 # ------------------------------------------------------------------- all at once
-def export(result: ResultFile, svg=None, dxf=None, stl=None) -> list:
+def export(result: ResultFile, svg=None, dxf=None, stl=None, stroke_mm: float | None = None,
+           margin_mm: float | None = None) -> list:
     """Write the fabrication files asked for; returns the paths written.
 
     Every file's contents are made first, then each is written atomically,
@@ -579,6 +626,8 @@ def export(result: ResultFile, svg=None, dxf=None, stl=None) -> list:
         Flat sheet outlines (needs :meth:`ResultFile.check_footprint` to pass).
     stl : path, optional
         The folded solid at ``result.positions``.
+    stroke_mm, margin_mm : float, optional
+        SVG stroke width and margin, mm (default: shares of the sheet's extent).
     """
     if not (svg or dxf or stl):
         raise ExportError("nothing to export: give --svg, --dxf and/or --stl")
@@ -588,9 +637,10 @@ def export(result: ResultFile, svg=None, dxf=None, stl=None) -> list:
     contents = []
     if svg or dxf:
         result.check_footprint()
-        outlines = sheet_outlines(result.mesh)
+        outlines = sheet_outlines(result.mesh, result.pattern)
         if svg:
-            contents.append((svg, svg_text(outlines, f"foldcore flat sheet of {result.source}")))
+            contents.append((svg, svg_text(outlines, f"foldcore flat sheet of {result.source}",
+                                           stroke_mm, margin_mm)))
         if dxf:
             contents.append((dxf, dxf_text(outlines)))
     if stl:

@@ -31,6 +31,16 @@ class Loaded:
     hinge: list | None
 
 
+class Interrupted(KeyboardInterrupt):
+    """Ctrl-C during the run: the last iterate was written as a partial result
+    (``foldcore:partial`` in the FOLD file, ``reason: "interrupted"`` in the
+    report) to ``written`` (option name → path); ``result`` is that iterate."""
+
+    def __init__(self, result, written: dict):
+        super().__init__()
+        self.result, self.written = result, written
+
+
 @dataclass
 class Fold:
     """A finished fold: what the command line reports from."""
@@ -74,8 +84,8 @@ def simulate(path, *, thickness: float | None = None, hinge_width: float | None 
              actuation: str = DEFAULT_ACTUATION, branch_floor: float = BRANCH_FLOOR_DEG,
              hinges=None, mv_passive: bool = False, trust_assignment: bool = False,
              scale: float | None = None, sheet_size: float | None = None,
-             output=None, report=None, render=None, animate=None, frames: int = 20,
-             fps: float = 10.0):
+             output=None, report=None, render=None, animate=None, series=None,
+             frames: int = 20, fps: float = 10.0, callback=None):
     """Fold the pattern file at ``path`` and write the outputs asked for; the Result.
 
     Parameters
@@ -98,10 +108,22 @@ def simulate(path, *, thickness: float | None = None, hinge_width: float | None 
         Result FOLD, JSON report, PNG render, GIF/MP4 of the sweep from 0 to
         ``fold_percent`` in ``frames`` frames at ``fps`` (the last frame's run is
         the result).
+    series : path, optional
+        The same sweep as one FOLD file, a frame per fold percent (achieved angles
+        and the folded solid, :func:`foldcore.outputs.series_frame`).
+    callback : callable(sim, moved_mm) -> bool or None, optional
+        Called after each iteration (:meth:`Simulation.run`); False stops the run.
 
     Returns
     -------
     Result
+
+    Raises
+    ------
+    Interrupted
+        Ctrl-C (KeyboardInterrupt) during the run: the last iterate is written to
+        the outputs asked for, marked partial, then this is raised (a
+        KeyboardInterrupt). A second Ctrl-C while writing leaves no file.
     """
     return fold(path, **{k: v for k, v in locals().items() if k != "path"}).result
 
@@ -132,20 +154,30 @@ def fold(path, **options) -> Fold:
         raise SimulationError(f"{source}: no thickness: pass --thickness H (mm) "
                               "or set foldcore:thickness in the file")
     check_destinations({"-o": o["output"], "--report": o["report"], "--render": o["render"],
-                        "--animate": o["animate"]}, inputs=(source, o["hinges"]),
-                       suffixes={"--render": (".png",)})
-    if o["animate"]:
+                        "--animate": o["animate"], "--series": o["series"]},
+                       inputs=(source, o["hinges"]),
+                       suffixes={"--render": (".png",), "--series": (".fold",)})
+    if o["animate"]:  # (an animation interrupted writes nothing: its frames are a sweep)
         from .animate import check_output
         check_output(o["animate"])          # a missing encoder fails before any work
     mesh = thicken(loaded.pattern, thickness, o["hinge_width"], o["subdivisions"],
                    hinge=o["hinge"] or loaded.hinge, stiffness=loaded.stiffness)
     sim = Simulation(mesh, loaded.pattern, solver=o["solver"], actuation=o["actuation"],
                      branch_floor_deg=o["branch_floor"])
+    interrupted, sweep = False, None
     if o["animate"]:
-        result = _animate(sim, o)
+        sweep = _animate(sim, o)
+    elif o["series"]:
+        sweep = _sweep(sim, o)
+    if sweep is not None:
+        result = sweep[-1][1]
     else:
         sim.set_fold_percent(o["fold_percent"])
-        result = sim.run(tolerance=o["tolerance"], max_iterations=o["max_iterations"])
+        try:
+            result = sim.run(tolerance=o["tolerance"], max_iterations=o["max_iterations"],
+                             callback=o["callback"])
+        except KeyboardInterrupt:  # the last complete iterate is a result too
+            result, interrupted = sim.result(False, "interrupted"), True
     summary, said = run_summary(result, loaded.pattern, source, o["fold_percent"])
     for text in said:
         warnings.warn(text, RunWarning, stacklevel=3)
@@ -154,8 +186,12 @@ def fold(path, **options) -> Fold:
     settings.update(thickness_mm=thickness, hinge=sorted(set(mesh.hinge_model) - {""}),
                     actuation=o["actuation"], branch_floor_deg=o["branch_floor"],
                     backend=sim.system.factor.backend)
+    outputs = {"-o": o["output"], "--report": o["report"], "--render": o["render"]}
     write_result(result, loaded.pattern, mesh, thickness, settings, fold=o["output"],
-                 report=o["report"], png=o["render"])
+                 report=o["report"], png=o["render"], partial=interrupted,
+                 series=o["series"], sweep=sweep)
+    if interrupted:
+        raise Interrupted(result, {k: v for k, v in outputs.items() if v})
     return Fold(loaded.pattern, mesh, sim, result, settings, summary)
 
 
@@ -171,16 +207,33 @@ def _with_defaults(options: dict) -> dict:
     return {**defaults, **options}
 
 
-def _animate(sim, o: dict):
+def _animate(sim, o: dict) -> list:
     """Fold ``sim`` from 0 to the fold percent in ``frames`` steps, write the movie;
-    the last frame's Result (a RunWarning counts unconverged intermediate frames)."""
+    [(percent, Result)] of every frame (:func:`_said_unconverged`)."""
     from .animate import animate, percent_schedule
+
+    percents = percent_schedule(o["frames"], o["fold_percent"])
+    movie = animate(sim, percents, o["animate"], fps=o["fps"], tolerance=o["tolerance"],
+                    max_iterations=o["max_iterations"])
+    return _said_unconverged(list(zip(map(float, percents), movie.results)))
+
+
+def _sweep(sim, o: dict) -> list:
+    """:func:`_animate` without the pictures (``--series`` alone)."""
+    from .animate import fold_sweep, percent_schedule
+
+    percents = percent_schedule(o["frames"], o["fold_percent"])
+    results = fold_sweep(sim, percents, tolerance=o["tolerance"],
+                         max_iterations=o["max_iterations"], progress=False)
+    return _said_unconverged(list(zip(map(float, percents), results)))
+
+
+def _said_unconverged(sweep: list) -> list:
+    """``sweep``, after a RunWarning counting its unconverged intermediate frames."""
     from .errors import RunWarning
 
-    movie = animate(sim, percent_schedule(o["frames"], o["fold_percent"]), o["animate"],
-                    fps=o["fps"], tolerance=o["tolerance"], max_iterations=o["max_iterations"])
-    unconverged = sum(not r.converged for r in movie.results[:-1])
+    unconverged = sum(not r.converged for _, r in sweep[:-1])
     if unconverged:
-        warnings.warn(f"{unconverged} of {len(movie.results) - 1} intermediate animation "
-                      "frames not converged", RunWarning, stacklevel=3)
-    return movie.results[-1]
+        warnings.warn(f"{unconverged} of {len(sweep) - 1} intermediate frames of the sweep "
+                      "not converged", RunWarning, stacklevel=4)
+    return sweep

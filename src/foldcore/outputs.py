@@ -12,6 +12,14 @@ import numpy as np
 from .io.fold import CELLS_KEY, HINGE_KEY, POISSON_KEY
 from .mesh import surface_faces
 
+#: FOLD key marking a result written from an interrupted run's last iterate.
+PARTIAL_KEY = "foldcore:partial"
+#: Keys of a series frame: its fold percent, and per key-frame edge the achieved
+#: angle and the effective target (degrees).
+SERIES_PERCENT_KEY = "foldcore:fold_percent"
+SERIES_ANGLE_KEY = "foldcore:pattern_foldAngle"
+SERIES_TARGET_KEY = "foldcore:pattern_targetAngle"
+
 
 def folded_frame(mesh, positions: np.ndarray) -> dict:
     """FOLD frame of the folded thick solid: 3D coordinates (mm) and surface faces."""
@@ -19,6 +27,22 @@ def folded_frame(mesh, positions: np.ndarray) -> dict:
             "frame_unit": "mm", "frame_parent": 0, "frame_inherit": False,
             "vertices_coords": np.asarray(positions).tolist(),
             "faces_vertices": [f.tolist() for f in surface_faces(mesh)]}
+
+
+def series_frame(mesh, result, percent: float) -> dict:
+    """One frame of a fold-percent series: the folded solid (as :func:`folded_frame`)
+    plus, per edge of the key frame's crease pattern, the achieved angles (within
+    FOLD's [−180°, 180°]) and the effective targets (degrees, null = passive), and
+    the frame's verdict."""
+    frame = folded_frame(mesh, result.positions)
+    targets = result.target_angles_deg
+    frame.update({"frame_title": f"fold percent {percent:g}", SERIES_PERCENT_KEY: percent,
+                  SERIES_ANGLE_KEY: _nullable(np.clip(result.fold_angles_deg, -180.0, 180.0)),
+                  SERIES_TARGET_KEY: None if targets is None else _nullable(targets),
+                  "foldcore:converged": bool(result.converged),
+                  "foldcore:reason": result.reason,
+                  "foldcore:iterations": int(result.iterations)})
+    return frame
 
 
 def _nullable(values) -> list:
@@ -67,8 +91,8 @@ def run_summary(result, pattern, source: str, fold_percent: float) -> tuple[str,
         warns.append(f"{source}: no crease is driven (no target angles): the sheet stays "
                      "as it is; give edges_foldAngle, or M/V creases without angles "
                      "(and no --mv-passive)")
-    elif result.converged and worst > MISS_WARNING_DEG:
-        missed = sum(abs(c["miss_deg"]) > MISS_WARNING_DEG for c in entries["creases"])
+    elif entries["binding"]:
+        missed = entries["missed"]
         warns.append(f"{source}: converged, but {missed} of {driven} driven creases miss "
                      f"their targets by more than {MISS_WARNING_DEG:g}° (up to {worst:.3g}°): "
                      "the model binds there — with rigid panels this pattern cannot reach "
@@ -78,7 +102,9 @@ def run_summary(result, pattern, source: str, fold_percent: float) -> tuple[str,
 
 
 def actuation_entries(result, pattern) -> dict:
-    """Per actuated crease: effective target, achieved angle and miss (degrees)."""
+    """Per actuated crease: effective target, achieved angle and miss (degrees); the
+    largest and median miss, how many miss by more than :data:`MISS_WARNING_DEG`, and
+    ``binding``: converged with some missed (the targets unreachable in this model)."""
     from .measure import wrapped_deg
 
     targets = result.target_angles_deg if result.target_angles_deg is not None \
@@ -90,8 +116,11 @@ def actuation_entries(result, pattern) -> dict:
                for e, t, a, m in zip(driven, targets[driven], result.fold_angles_deg[driven],
                                      miss)]
     worst = float(np.abs(miss).max()) if len(miss) else 0.0
+    missed = int(np.count_nonzero(np.abs(miss) > MISS_WARNING_DEG))
     return {"creases": creases, "largest_miss_deg": worst,
-            "median_miss_deg": float(np.median(np.abs(miss))) if len(miss) else 0.0}
+            "median_miss_deg": float(np.median(np.abs(miss))) if len(miss) else 0.0,
+            "missed": missed, "miss_tolerance_deg": MISS_WARNING_DEG,
+            "binding": bool(result.converged and missed > 0)}
 
 
 def hinge_entries(result, pattern, mesh) -> dict:
@@ -197,7 +226,8 @@ def _mesh_recipe(pattern, mesh) -> dict | None:
 
 
 def write_result(result, pattern, mesh, thickness: float, settings: dict, *, fold=None,
-                 report=None, png=None, quantities: dict | None = None) -> None:
+                 report=None, png=None, quantities: dict | None = None,
+                 partial: bool = False, series=None, sweep=None) -> None:
     """Write the outputs asked for: FOLD (achieved angles + folded solid), JSON report, PNG.
 
     Parameters
@@ -215,19 +245,37 @@ def write_result(result, pattern, mesh, thickness: float, settings: dict, *, fol
         written (:func:`foldcore.destinations.all_or_nothing`).
     quantities : dict, optional
         A scene's own measurements, stored in the report.
+    partial : bool
+        The run was interrupted: the FOLD file gets ``"foldcore:partial": true``
+        and the report ``"partial": true`` (its ``reason`` is the Result's).
+    series : path, optional
+        With ``sweep`` (a list of (fold percent, Result), in order): one FOLD file
+        whose key frame is the crease pattern with the last frame's achieved
+        angles and whose ``file_frames`` are :func:`series_frame` of each (the
+        last is what ``foldcore render`` draws).
     """
     from .destinations import all_or_nothing
 
-    with all_or_nothing({"png": png, "fold": fold, "report": report}) as tmp:
+    with all_or_nothing({"png": png, "fold": fold, "report": report,
+                         "series": series}) as tmp:
+        if series:
+            from .io import write_fold
+            write_fold(tmp["series"], pattern, achieved_angles=np.clip(
+                result.fold_angles_deg, -180.0, 180.0),
+                frames=[series_frame(mesh, r, p) for p, r in sweep], thickness=thickness,
+                extra=_mesh_recipe(pattern, mesh))
         if png:
             from .render import render_png
             render_png(pattern, mesh, result.positions, tmp["png"])
         if fold:
             from .io import write_fold
+            extra = {**(_mesh_recipe(pattern, mesh) or {}),
+                     **({PARTIAL_KEY: True} if partial else {})}
             write_fold(tmp["fold"], pattern, achieved_angles=np.clip(  # FOLD's range
                 result.fold_angles_deg, -180.0, 180.0),
                        frames=[folded_frame(mesh, result.positions)], thickness=thickness,
-                       extra=_mesh_recipe(pattern, mesh))
+                       extra=extra or None)
         if report:
-            write_report(tmp["report"], report_dict(result, pattern, mesh, settings,
-                                                    quantities))
+            write_report(tmp["report"], {**report_dict(result, pattern, mesh, settings,
+                                                       quantities),
+                                         **({"partial": True} if partial else {})})

@@ -81,6 +81,7 @@ class Result:
         tolerance, or the plain map's rate too slow for the budget, but the
         equilibrium not reached: :mod:`foldcore.verdict`); ``"budget"``
         (``max_iterations`` ran out); ``"callback"`` (the callback returned False);
+        ``"interrupted"`` (Ctrl-C: :func:`foldcore.simulate` keeps the last iterate);
         ``"none"`` for a snapshot taken outside a run
     residual : float, the estimated distance to the equilibrium at the end, relative to
         the pattern size (dimensionless): the probe's estimate for the local/global

@@ -1,0 +1,130 @@
+"""``foldcore.simulate`` and what a run tells its user (issue 19, items 3, 4, 6): the
+summary line, the binding and nothing-driven warnings, the progress bar, and the
+last iterate written as a partial result on Ctrl-C."""
+from __future__ import annotations
+
+import json
+import warnings
+
+import numpy as np
+import pytest
+
+import foldcore
+from foldcore import cli, patterns
+from foldcore.errors import RunWarning
+from foldcore.io import write_fold
+from foldcore.job import Interrupted
+from foldcore.simulation import Simulation
+
+REAL = "tests/data/real/"
+
+
+@pytest.fixture
+def hinge_file(tmp_path):
+    pattern = patterns.single_hinge(panel_length=5.0, depth=2.0, angle=90.0, width=2.0)
+    path = tmp_path / "hinge.fold"
+    write_fold(path, pattern, thickness=1.0)
+    return path
+
+
+def test_simulate_is_the_command_line_as_a_call(hinge_file, tmp_path):
+    """Same options, same outputs: the FOLD result of the call equals the CLI's."""
+    options = ["--subdivisions", "4", "--tolerance", "1e-9", "--max-iterations", "20000"]
+    assert cli.main(["simulate", str(hinge_file), "-o", str(tmp_path / "cli.fold"),
+                     "-q", *options]) == 0
+    result = foldcore.simulate(hinge_file, subdivisions=4, tolerance=1e-9,
+                               max_iterations=20_000, output=tmp_path / "api.fold")
+    assert result.converged and result.fold_angles_deg[0] == pytest.approx(90.0, abs=1e-4)
+    a, b = (json.loads((tmp_path / n).read_text()) for n in ("cli.fold", "api.fold"))
+    assert a["edges_foldAngle"] == b["edges_foldAngle"]
+    assert a["file_frames"][0]["vertices_coords"] == b["file_frames"][0]["vertices_coords"]
+    with pytest.raises(TypeError):
+        foldcore.job.fold(hinge_file, thickness_mm=1.0)
+
+
+def test_the_summary_line_gives_verdict_iterations_time_and_miss(hinge_file, capsys):
+    assert cli.main(["simulate", str(hinge_file), "--subdivisions", "4"]) == 0
+    (line,) = capsys.readouterr().err.splitlines()
+    assert line.startswith(f"foldcore: {hinge_file}: converged after ")
+    assert " iterations in " in line and "1 driven creases at fold percent 100" in line
+    assert "miss max " in line
+    assert cli.main(["simulate", str(hinge_file), "--subdivisions", "4", "-q"]) == 0
+    assert capsys.readouterr().err == ""
+
+
+def test_nothing_driven_is_said(tmp_path, capsys):
+    """The crane read with --mv-passive: every crease passive, the sheet stays flat."""
+    assert cli.main(["simulate", REAL + "crane.fold", "--mv-passive", "--thickness", "1",
+                     "--sheet-size", "200", "-q"]) == 0
+    (line,) = capsys.readouterr().err.splitlines()
+    assert "crane.fold: no crease is driven" in line
+
+
+def test_a_run_that_binds_converged_says_its_targets_were_missed():
+    """Origami Simulator's waterbomb base at 30 %: its panels cannot fold rigidly to
+    the drawn angles; converged with every driven crease far off, and said so."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        result = foldcore.simulate(REAL + "bird-base-3d.fold", thickness=0.5,
+                                   sheet_size=100, fold_percent=30, max_iterations=3000)
+    binding = [str(w.message) for w in caught if w.category is RunWarning]
+    assert result.converged
+    (message,) = binding
+    assert "miss their targets by more than 1°" in message and "bird-base-3d" in message
+
+
+def test_no_progress_bar_without_a_terminal_or_with_quiet(hinge_file, monkeypatch):
+    args = cli.build_parser().parse_args(["simulate", str(hinge_file)])
+    assert cli._progress(args) is None  # pytest's stderr is not a terminal
+    monkeypatch.setattr(cli.sys.stderr, "isatty", lambda: True, raising=False)
+    bar = cli._progress(args)
+    assert bar is not None
+    bar.close()
+    args.quiet = True
+    assert cli._progress(args) is None
+
+
+def test_ctrl_c_writes_the_last_iterate_marked_partial(hinge_file, tmp_path, capsys,
+                                                       monkeypatch):
+    step, calls = Simulation._step, []
+
+    def interrupted_step(self):
+        calls.append(1)
+        if len(calls) == 30:
+            raise KeyboardInterrupt
+        return step(self)
+
+    monkeypatch.setattr(Simulation, "_step", interrupted_step)
+    out, report = tmp_path / "o.fold", tmp_path / "r.json"
+    code = cli.main(["simulate", str(hinge_file), "--subdivisions", "4", "--solver", "paper",
+                     "-o", str(out), "--report", str(report)])
+    assert code == cli.EXIT_SIGINT
+    (line,) = capsys.readouterr().err.splitlines()
+    assert "interrupted (SIGINT) after 29 iterations" in line and str(out) in line
+    fold, rep = json.loads(out.read_text()), json.loads(report.read_text())
+    assert fold["foldcore:partial"] is True
+    assert rep["partial"] is True and rep["reason"] == "interrupted"
+    assert rep["iterations"] == 29 and rep["converged"] is False
+    assert 0.0 < rep["fold_angles_deg"][0] < 90.0  # part way
+    with pytest.raises(Interrupted) as info:
+        calls.clear()
+        foldcore.simulate(hinge_file, subdivisions=4, solver="paper")
+    assert info.value.result.iterations == 29 and info.value.written == {}
+    assert np.isfinite(info.value.result.positions).all()
+
+
+def test_the_readme_snippet_renders(tmp_path, monkeypatch):
+    """The README's library snippet runs as printed, and ``foldcore render`` accepts
+    the result it writes (its old ``write_fold`` of achieved angles had no folded
+    frame, and render refused it)."""
+    import pathlib
+    import re
+
+    readme = (pathlib.Path(__file__).parents[1] / "README.md").read_text()
+    library = readme.split("## Library", 1)[1]
+    code = re.search(r"```python\n(.*?)```", library, re.S).group(1)
+    monkeypatch.chdir(tmp_path)
+    exec(compile(code, "README.md", "exec"), {})
+    assert json.loads((tmp_path / "hinge.json").read_text())["converged"] is True
+    assert cli.main(["render", "hinge-folded.fold", "-o", "h.png", "--size", "160x120"]) == 0
+    assert (tmp_path / "h.png").stat().st_size > 0
