@@ -1,5 +1,6 @@
 """Command line: ``foldcore simulate PATTERN [options]``, ``foldcore render RESULT.fold -o
 OUT.png [options]``, ``foldcore export RESULT.fold --svg/--dxf/--stl OUT``,
+``foldcore view RESULT.fold -o OUT.html`` (:mod:`foldcore.view`),
 ``foldcore scene NAME [--out DIR] [--render]`` (the paper's scenes, :mod:`foldcore.scenes`).
 
 ``simulate --animate OUT.gif|OUT.mp4`` also folds the pattern from 0 to
@@ -216,6 +217,11 @@ def build_parser() -> argparse.ArgumentParser:
                      help="SVG margin around the sheet in mm (default: 2%% of the sheet)")
     _add_rebuild_options(exp)
 
+    view = sub.add_parser("view", help="a self-contained interactive HTML page of a result "
+                                       "FOLD (simulate -o or --series)")
+    view.add_argument("result", help="FOLD file written by foldcore simulate -o / --series")
+    view.add_argument("-o", "--output", required=True, help="HTML page to write")
+
     from .scenes import NAMES
 
     scn = sub.add_parser("scene", help="fold one of the paper's scenes and write its outputs")
@@ -381,8 +387,18 @@ def export_result(args) -> int:
     return 0
 
 
+def view_result(args) -> int:
+    """Run ``foldcore view`` (:mod:`foldcore.view`); raises FoldcoreError on bad input."""
+    from .view import view_html
+
+    check_destinations({"-o": args.output}, inputs=(args.result,),
+                       suffixes={"-o": (".html", ".htm")})
+    view_html(args.result, args.output)
+    return 0
+
+
 COMMANDS = {"simulate": simulate, "render": render_result, "export": export_result,
-            "scene": run_scene}
+            "view": view_result, "scene": run_scene}
 
 
 class Terminated(BaseException):

@@ -1,0 +1,95 @@
+"""``simulate --series`` and ``foldcore view`` (issue 19, item 7): the fold-percent
+sweep as one FOLD file, and a self-contained page that shows it, loaded in headless
+Chromium (Debian's, installed by ``make test``) and checked on its screenshots."""
+from __future__ import annotations
+
+import json
+import subprocess
+
+import numpy as np
+import pytest
+
+from foldcore.cli import main
+from foldcore.fabrication import read_result
+
+CHROMIUM = "/usr/bin/chromium"
+FLAGS = ["--headless", "--no-sandbox", "--disable-gpu", "--enable-unsafe-swiftshader",
+         "--use-angle=swiftshader", "--disable-background-networking",
+         "--disable-component-update", "--disable-sync", "--no-first-run",
+         "--window-size=640,480", "--virtual-time-budget=10000"]
+
+
+@pytest.fixture(scope="module")
+def series(tmp_path_factory):
+    """Origami Simulator's waterbomb base swept to 90 % in 4 frames."""
+    path = tmp_path_factory.mktemp("series") / "wb.fold"
+    assert main(["simulate", "tests/data/real/waterbombBase.svg", "--thickness", "0.5",
+                 "--sheet-size", "100", "--fold-percent", "90", "--frames", "4",
+                 "--series", str(path), "-q"]) == 0
+    return path
+
+
+def test_the_series_has_a_frame_per_fold_percent_with_its_angles(series):
+    d = json.loads(series.read_text())
+    frames = d["file_frames"]
+    assert [f["foldcore:fold_percent"] for f in frames] == [0.0, 30.0, 60.0, 90.0]
+    edges = len(d["edges_vertices"])
+    largest = []
+    for f in frames:
+        assert "foldedForm" in f["frame_classes"] and len(f["foldcore:pattern_foldAngle"]) == edges
+        targets = [t for t in f["foldcore:pattern_targetAngle"] if t is not None]
+        assert max(map(abs, targets)) == pytest.approx(180.0 * f["foldcore:fold_percent"] / 100)
+        largest.append(max(abs(a) for a in f["foldcore:pattern_foldAngle"] if a is not None))
+    assert largest[0] < 1e-6 and np.all(np.diff(largest) > 10.0)  # folding further each frame
+    res = read_result(series)  # render/export take the last frame
+    assert res.positions == pytest.approx(np.array(frames[-1]["vertices_coords"]))
+
+
+def chromium(url: str, *extra) -> subprocess.CompletedProcess:
+    return subprocess.run([CHROMIUM, *FLAGS, *extra, url], capture_output=True, text=True,
+                          timeout=120)
+
+
+def screenshot(page, tmp_path, fragment: str) -> np.ndarray:
+    import imageio.v3 as iio
+
+    shot = tmp_path / f"shot-{fragment.replace('&', '-').replace('=', '')}.png"
+    chromium(f"file://{page}#{fragment}", f"--user-data-dir={tmp_path / 'profile'}",
+             f"--screenshot={shot}")
+    return iio.imread(shot)[..., :3].astype(int)
+
+
+def count(image, hue: str) -> int:
+    """Reddish or bluish pixels (one channel ≥ 60 above the other two; the thin hinges
+    are shaded and antialiased) below the controls (the top 60 rows)."""
+    r, g, b = np.moveaxis(image[60:], 2, 0)
+    main, others = (r, (g, b)) if hue == "red" else (b, (r, g))
+    return int(((main - others[0] >= 60) & (main - others[1] >= 60)).sum())
+
+
+def test_the_page_is_self_contained_and_shows_each_frame(series, tmp_path):
+    page = tmp_path / "view.html"
+    assert main(["view", str(series), "-o", str(page)]) == 0
+    text = page.read_text()
+    assert "<script src" not in text and "@import" not in text  # nothing fetched
+    dom = chromium(f"file://{page}", f"--user-data-dir={tmp_path / 'profile'}",
+                   "--dump-dom").stdout
+    assert 'data-ready="yes"' in dom and 'data-frames="4"' in dom, dom[-500:]
+    flat, folded = (screenshot(page, tmp_path, f"frame={k}") for k in (0, 3))
+    ink = lambda im: int((im.sum(axis=2) < 740).sum())  # noqa: E731  non-white pixels
+    assert ink(flat) > 1000 and ink(folded) > 1000
+    assert np.abs(flat - folded).sum(axis=2).astype(bool).mean() > 0.01  # it moved
+    assert count(folded, "red") > 0 and count(folded, "blue") > 0  # M/V colours by default
+    assert count(flat, "red") > 0  # the flat sheet's hinges show their M/V colours ...
+    flat_angles = screenshot(page, tmp_path, "frame=0&colour=angle")  # ... not their angles
+    assert count(flat_angles, "red") == count(flat_angles, "blue") == 0  # flat: angles ~0
+
+
+def test_view_refuses_what_it_cannot_show_in_one_line(tmp_path, capsys):
+    pattern = tmp_path / "p.svg"
+    pattern.write_text("<svg/>")
+    assert main(["view", str(pattern), "-o", str(tmp_path / "v.html")]) == 2
+    assert main(["view", str(pattern), "-o", str(tmp_path / "v.png")]) == 2
+    lines = capsys.readouterr().err.splitlines()
+    assert len(lines) == 2 and all(line.startswith("foldcore: error: ") for line in lines)
+    assert not (tmp_path / "v.html").exists()
