@@ -128,3 +128,36 @@ def test_the_readme_snippet_renders(tmp_path, monkeypatch):
     assert json.loads((tmp_path / "hinge.json").read_text())["converged"] is True
     assert cli.main(["render", "hinge-folded.fold", "-o", "h.png", "--size", "160x120"]) == 0
     assert (tmp_path / "h.png").stat().st_size > 0
+
+
+def test_a_crease_past_flat_reads_back_and_keeps_its_side(tmp_path):
+    """Issue 19: a mountain folded 0.54° past flat was written +179.46° and foldcore
+    refused its own output ('contradicts assignment M'). Now measured angles keep
+    their side (``on_assigned_side``): here the valley at 180.54° is kept in the
+    report, written within FOLD's range, and render/export read it back."""
+    import dataclasses
+
+    from folded import scene
+    from foldcore.fabrication import read_result
+    from foldcore.outputs import write_result
+
+    pattern, mesh, result = scene("hinge")
+    crease = int(pattern.creases[0])
+    angles = result.fold_angles_deg.copy()
+    assert pattern.assignments[crease] == "V"
+    angles[crease] = 180.54
+    past = dataclasses.replace(result, fold_angles_deg=angles)
+    out, report = tmp_path / "past.fold", tmp_path / "past.json"
+    write_result(past, pattern, mesh, 1.0, {}, fold=out, report=report)
+    assert json.loads(out.read_text())["edges_foldAngle"][crease] == 180.0
+    assert json.loads(report.read_text())["fold_angles_deg"][crease] == 180.54
+    read_result(out)  # no contradiction raised
+
+
+def test_the_report_gives_the_effective_targets_at_the_fold_percent(hinge_file, tmp_path):
+    """The crane at 30 % reported target_angles_deg 180 (the file's, not the run's)."""
+    report = tmp_path / "r.json"
+    foldcore.simulate(hinge_file, subdivisions=4, fold_percent=30, report=report)
+    rep = json.loads(report.read_text())
+    assert rep["target_angles_deg"][0] == pytest.approx(27.0)  # 30 % of 90°
+    assert rep["actuation"]["creases"][0]["target_deg"] == pytest.approx(27.0)

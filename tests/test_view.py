@@ -61,8 +61,8 @@ def screenshot(page, tmp_path, fragment: str) -> np.ndarray:
 
 def count(image, hue: str) -> int:
     """Reddish or bluish pixels (one channel ≥ 60 above the other two; the thin hinges
-    are shaded and antialiased) below the controls (the top 60 rows)."""
-    r, g, b = np.moveaxis(image[60:], 2, 0)
+    are shaded and antialiased) below the controls (the top 80 rows)."""
+    r, g, b = np.moveaxis(image[80:], 2, 0)
     main, others = (r, (g, b)) if hue == "red" else (b, (r, g))
     return int(((main - others[0] >= 60) & (main - others[1] >= 60)).sum())
 
@@ -83,6 +83,10 @@ def test_the_page_is_self_contained_and_shows_each_frame(series, tmp_path):
     assert count(flat, "red") > 0  # the flat sheet's hinges show their M/V colours ...
     flat_angles = screenshot(page, tmp_path, "frame=0&colour=angle")  # ... not their angles
     assert count(flat_angles, "red") == count(flat_angles, "blue") == 0  # flat: angles ~0
+    strained, unstrained = (screenshot(page, tmp_path, f"frame={k}&colour=strain")
+                            for k in (3, 0))
+    yellow = lambda im: int(((im[80:, :, :2].min(axis=2) - im[80:, :, 2]) >= 60).sum())  # noqa: E731
+    assert yellow(strained) > 0 and yellow(unstrained) == 0  # the largest strain: folded
 
 
 def test_view_refuses_what_it_cannot_show_in_one_line(tmp_path, capsys):

@@ -5,9 +5,11 @@ package, ``viewer_assets/README.md``) and the geometry are inlined, the
 library through an import map of ``data:`` URLs. The page draws the folded
 thick solid with orbit controls, a slider over the file's folded frames (a
 ``simulate --series`` file has one per fold percent; a ``simulate -o`` result
-has one) and two colourings: mountain/valley (Origami Simulator's red/blue,
-panels grey, facet yellow, undriven magenta) and each crease's achieved fold
-angle (valley blue, mountain red). ``#frame=K&colour=angle`` in the URL
+has one) and three colourings: mountain/valley (Origami Simulator's red/blue,
+panels grey, facet yellow, undriven magenta), each crease's achieved fold
+angle (valley blue, mountain red), and each hinge sub-strip's larger surface
+strain (dark to yellow, 0 to the largest over the frames; as ``foldcore render
+--color-by strain``). ``#frame=K&colour=angle`` in the URL
 chooses the first view (used by the tests). Geometry: the outer surface of
 the thick mesh rebuilt from the file (:func:`foldcore.fabrication.read_result`),
 float32 positions per frame, base64-encoded.
@@ -48,9 +50,14 @@ def view_html(path, output) -> None:
     kind = np.zeros(len(triangles), dtype=np.uint8)
     hinge = crease >= 0
     kind[hinge] = [KINDS.get(str(res.pattern.assignments[e]), 4) for e in crease[hinge]]
+    bending = surface.group[face] == "bending_hinge"
+    strip = np.where(bending, surface.element[face], -1).astype(np.int32)
+    frames = _frames(d, res.mesh.n_vertices, source)
+    for frame, xyz in frames:
+        frame["strain"] = _b64(_strip_strains(res.mesh, xyz).astype("<f4"))
     data = {"triangles": _b64(triangles.astype("<u4")), "kind": _b64(kind),
-            "crease": _b64(crease.astype("<i4")),
-            "frames": _frames(d, res.mesh.n_vertices, source)}
+            "crease": _b64(crease.astype("<i4")), "strip": _b64(strip),
+            "frames": [frame for frame, _ in frames]}
     page = (ASSETS / "view.html").read_text()
     page = page.replace("__TITLE__", f"foldcore: {Path(source).name}")
     page = page.replace("__IMPORTMAP__", json.dumps({"imports": {
@@ -61,9 +68,21 @@ def view_html(path, output) -> None:
         fh.write(page)
 
 
+def _strip_strains(mesh, positions: np.ndarray) -> np.ndarray:
+    """(S,) each bending sub-strip's larger surface tension strain at ``positions``
+    (as ``foldcore render --color-by strain``; dimensionless)."""
+    from .strain import estimated_strip_angles, strip_strains
+
+    hinges = mesh.groups.get("bending_hinge")
+    if hinges is None or not len(hinges):
+        return np.zeros(0)
+    return strip_strains(hinges.params, estimated_strip_angles(hinges, positions)).max(axis=1)
+
+
 def _frames(d: dict, n_vertices: int, source: str) -> list:
-    """Every folded frame of the file with the mesh's vertex count, in order: title,
-    (N·3) float32 positions (base64) and per key-frame edge achieved angles."""
+    """Every folded frame of the file with the mesh's vertex count, in order, as (page
+    entry, positions): title, (N·3) float32 positions (base64) and per key-frame edge
+    achieved angles; positions (N, 3) mm."""
     from .errors import PatternError
     from .outputs import SERIES_ANGLE_KEY
 
@@ -76,8 +95,8 @@ def _frames(d: dict, n_vertices: int, source: str) -> list:
             raise PatternError(f"{source}: file_frames[{i}] has {len(xyz)} vertices, the "
                                f"rebuilt thick mesh {n_vertices}")
         angles = f.get(SERIES_ANGLE_KEY, d.get("edges_foldAngle"))
-        out.append({"title": str(f.get("frame_title", f"frame {i}")),
-                    "xyz": _b64(xyz.astype("<f4")), "angles": angles})
+        out.append(({"title": str(f.get("frame_title", f"frame {i}")),
+                     "xyz": _b64(xyz.astype("<f4")), "angles": angles}, xyz))
     return out
 
 
