@@ -171,3 +171,19 @@ def test_cli_scene_writes_outputs_and_refuses_bad_input(tmp_path, capsys):
     assert main(["scene", "teapot"]) == 2
     err = capsys.readouterr().err
     assert "missing: output folder does not exist" in err and "invalid choice: 'teapot'" in err
+
+
+def test_the_hinge_study_picture_shows_every_run(runs, tmp_path):
+    """It showed 1 of its 18 runs (issue 19): now a tile per (hinge model, W, k), each
+    titled with its achieved angle."""
+    import imageio.v3 as iio
+
+    scene = runs["hinge-study"]
+    assert len(scene.gallery) == len(scene.quantities["runs"]) == 18
+    written = scenes.write(scene, tmp_path, png=True)
+    image = iio.imread([p for p in written if str(p).endswith(".png")][0])
+    tile_w, tile_h = scenes.TILE
+    assert image.shape[:2] == (3 * tile_h, scenes.TILES_PER_ROW * tile_w)
+    tiles = [image[r * tile_h:(r + 1) * tile_h, c * tile_w:(c + 1) * tile_w, :3]
+             for r in range(3) for c in range(scenes.TILES_PER_ROW)]
+    assert all((t.astype(int).sum(axis=2) < 600).mean() > 0.05 for t in tiles)  # each drawn

@@ -227,7 +227,7 @@ def _mesh_recipe(pattern, mesh) -> dict | None:
 
 def write_result(result, pattern, mesh, thickness: float, settings: dict, *, fold=None,
                  report=None, png=None, quantities: dict | None = None,
-                 partial: bool = False, series=None, sweep=None) -> None:
+                 partial: bool = False, series=None, sweep=None, picture=None) -> None:
     """Write the outputs asked for: FOLD (achieved angles + folded solid), JSON report, PNG.
 
     Parameters
@@ -248,6 +248,8 @@ def write_result(result, pattern, mesh, thickness: float, settings: dict, *, fol
     partial : bool
         The run was interrupted: the FOLD file gets ``"foldcore:partial": true``
         and the report ``"partial": true`` (its ``reason`` is the Result's).
+    picture : (H, W, 3) uint8, optional
+        Written as the PNG instead of a render of ``result`` (a scene's gallery).
     series : path, optional
         With ``sweep`` (a list of (fold percent, Result), in order): one FOLD file
         whose key frame is the crease pattern with the last frame's achieved
@@ -264,7 +266,10 @@ def write_result(result, pattern, mesh, thickness: float, settings: dict, *, fol
                 result.fold_angles_deg, -180.0, 180.0),
                 frames=[series_frame(mesh, r, p) for p, r in sweep], thickness=thickness,
                 extra=_mesh_recipe(pattern, mesh))
-        if png:
+        if png and picture is not None:
+            import imageio.v3 as iio
+            iio.imwrite(tmp["png"], picture, extension=".png")
+        elif png:
             from .render import render_png
             render_png(pattern, mesh, result.positions, tmp["png"])
         if fold:

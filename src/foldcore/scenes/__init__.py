@@ -16,6 +16,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from importlib import import_module
 
+import numpy as np
+
 from ..errors import FoldcoreError
 
 NAMES = {
@@ -46,6 +48,9 @@ class SceneRun:
         The scene's own measurements (JSON-ready; angles in degrees, lengths mm).
     settings : dict
         Solver, tolerances and budgets used (JSON-ready).
+    gallery : list of (title, pattern, mesh, positions)
+        A scene of several runs (hinge-study): each run's folded state, drawn
+        side by side in NAME.png (:func:`write`); empty: the PNG is ``result``.
     """
 
     name: str
@@ -55,6 +60,7 @@ class SceneRun:
     result: object
     quantities: dict = field(default_factory=dict)
     settings: dict = field(default_factory=dict)
+    gallery: list = field(default_factory=list)
 
 
 def run(name: str, quick: bool = False, solver: str | None = None) -> SceneRun:
@@ -95,6 +101,27 @@ def write(scene: SceneRun, out, png: bool = True) -> list:
     base = folder / scene.name
     paths = {"fold": base.with_suffix(".fold"), "report": base.with_suffix(".json"),
              "png": base.with_suffix(".png") if png else None}
+    picture = gallery_image(scene.gallery) if png and scene.gallery else None
     write_result(scene.result, scene.pattern, scene.mesh, scene.thickness,
-                 {"scene": scene.name, **scene.settings}, quantities=scene.quantities, **paths)
+                 {"scene": scene.name, **scene.settings}, quantities=scene.quantities,
+                 picture=picture, **paths)
     return [p for p in paths.values() if p is not None]
+
+
+#: Pixels of one gallery tile, and tiles per row.
+TILE, TILES_PER_ROW = (320, 240), 6
+
+
+def gallery_image(gallery: list) -> np.ndarray:
+    """(H, W, 3) uint8: each (title, pattern, mesh, positions) rendered in a tile of
+    ``TILE`` pixels, ``TILES_PER_ROW`` to a row (white where a row is short)."""
+    from ..animate import render_frames
+
+    tiles = [render_frames(pattern, mesh, [positions], size=TILE, titles=[title],
+                           progress=False)[0] for title, pattern, mesh, positions in gallery]
+    rows = []
+    for start in range(0, len(tiles), TILES_PER_ROW):
+        row = tiles[start:start + TILES_PER_ROW]
+        row += [np.full_like(tiles[0], 255)] * (TILES_PER_ROW - len(row))
+        rows.append(np.hstack(row))
+    return np.vstack(rows)

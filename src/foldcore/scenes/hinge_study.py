@@ -46,7 +46,7 @@ def run(quick: bool = False, solver: str | None = None) -> SceneRun:
     """Fold the hinge for every (hinge model, W, k) (module docstring); the last is the result."""
     solver = solver or "rigid"
     budget = (100 if quick else 400) if solver == "rigid" else (5_000 if quick else 60_000)
-    rows = []
+    rows, gallery = [], []
     for model, width, k in itertools.product(MODELS, WIDTHS, SUBDIVISIONS):
         pattern = single_hinge(panel_length=PANEL, depth=DEPTH, angle=ANGLE, width=width)
         mesh = thicken(pattern, THICKNESS, subdivisions=k, hinge=model)
@@ -62,9 +62,12 @@ def run(quick: bool = False, solver: str | None = None) -> SceneRun:
                                          5),
             "inner_gap_mm": round(inner_gap(pattern, mesh, result.positions), 5),
             "iterations": int(result.iterations), "converged": bool(result.converged)})
+        gallery.append((f"{model} W {width:g} k {k}: {achieved:.2f}°", pattern, mesh,
+                        result.positions))
     settings = {"solver": solver, "tolerance": TOLERANCE, "max_iterations": budget,
                 "thickness_mm": THICKNESS, "panel_mm": PANEL, "depth_mm": DEPTH}
-    return SceneRun("hinge-study", pattern, mesh, THICKNESS, result, {"runs": rows}, settings)
+    return SceneRun("hinge-study", pattern, mesh, THICKNESS, result, {"runs": rows}, settings,
+                    gallery)
 
 
 
