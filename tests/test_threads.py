@@ -94,3 +94,46 @@ def test_overlapping_guards_from_two_threads_restore_the_original_setting(monkey
     worker.join()
     assert seen["b_after_a_closed"] == 1
     assert setting["threads"] == 2 and threads._depth == 0
+
+
+def test_the_thread_chooser_follows_the_faster_count_and_backs_off_its_probes():
+    """ThreadChooser, fed step times: parallel while it is faster, serial once the
+    cores are shared (a parallel step waits for a descheduled thread), probing the
+    slower count at doubling intervals, and back to parallel when the load ends."""
+    from foldcore.threads import ThreadChooser
+
+    chooser = ThreadChooser(2)
+    cost = {1: 1.0, 2: 0.6}  # quiet: parallel faster
+    counts = []
+    for _ in range(200):
+        t = chooser.next()
+        counts.append(t)
+        chooser.record(t, cost[t])
+    assert counts[0] == 2 and chooser.best() == 2
+    assert 1 <= counts.count(1) <= 200 / ThreadChooser.EXPLORE_EVERY  # only probes
+    probes = [i for i, t in enumerate(counts) if t == 1]
+    assert np.all(np.diff(probes) >= ThreadChooser.EXPLORE_EVERY)
+    assert np.diff(probes)[-1] > np.diff(probes)[0]  # backed off
+    cost = {1: 2.0, 2: 20.0}  # loaded: parallel steps wait a time slice
+    loaded = []
+    for _ in range(400):
+        t = chooser.next()
+        loaded.append(t)
+        chooser.record(t, cost[t])
+    assert chooser.best() == 1 and loaded[-100:].count(2) <= 2
+    assert loaded.count(2) <= 20  # the switch took a few probes, then few more
+    cost = {1: 1.0, 2: 0.6}  # quiet again
+    for _ in range(2 * ThreadChooser.EXPLORE_MOST):
+        t = chooser.next()
+        chooser.record(t, cost[t])
+    assert chooser.best() == 2
+
+
+def test_a_simulation_keeps_the_users_thread_count():
+    from foldcore import Simulation, patterns, thicken
+
+    pattern = patterns.miura_one_crease(5, 5, width=0.6)
+    mesh = thicken(pattern, 0.2)
+    assert Simulation(mesh, pattern, threads=1)._chooser is None
+    sim = Simulation(mesh, pattern)
+    assert sim._chooser is not None and sim._chooser.most == sim.threads

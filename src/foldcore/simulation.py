@@ -20,7 +20,7 @@ from .errors import SimulationError
 from .measure import fold_angles
 from .strategies import DEFAULT_SOLVER
 from .system import System
-from .threads import blas_on_one_thread
+from .threads import ThreadChooser, blas_on_one_thread
 from .verdict import EquilibriumCheck
 
 ALPHA_UPDATE_EVERY = 10  # iterations between α-schedule updates (each costs a refactor)
@@ -30,6 +30,11 @@ STOP_LEAVE = 1e-3  # rad back inside its interval before a stop is released
 # 2-core Xeon, paper map, ms/iteration 1 vs 2 threads: Miura 2×2 (108 slots) 0.070 vs
 # 0.063 quiet / 2.3 with the cores busy; 5×5 (936) 0.41 vs 0.28; 10×10 (4 076) 1.77 vs 1.09.
 SERIAL_BELOW_SLOTS = 500
+#: Vector length (3 × vertices) from which a serial simulation's steps hold BLAS to
+#: one thread too: OpenBLAS threads its dot products of such vectors, and its spinning
+#: threads made an L-BFGS step of a Miura 10 × 10 (3 356 vertices) cost 63× its quiet
+#: median at the 95th percentile with the cores busy (bench/load.py).
+BLAS_GUARD_FROM = 10_000
 BARE_SOLVE_REPEATS = 5  # solves timed for the per-iteration cost floor
 
 
@@ -221,7 +226,10 @@ class Simulation:
         one thread below ``SERIAL_BELOW_SLOTS`` element-vertex slots (a
         parallel launch costs more than it saves there, and on a busy machine
         a launch can wait milliseconds for a descheduled thread, measured),
-        else numba's setting.
+        else up to numba's setting, each step with one thread or all of
+        them, whichever the recent steps found faster
+        (:class:`foldcore.threads.ThreadChooser`: on a shared machine the
+        serial steps win).
     """
 
     def __init__(self, mesh, pattern, solver: str = DEFAULT_SOLVER, backend: str = "auto",
@@ -242,6 +250,9 @@ class Simulation:
                 self._runs.append(_GroupRun(g, offset))
                 offset += len(g.indices)
         self.threads = self._choose_threads(threads, offset)
+        # the user's count is kept; the default one adapts to the machine's load
+        self._chooser = ThreadChooser(self.threads) if threads is None else None
+        self._guard_blas = self.threads > 1 or 3 * mesh.n_vertices >= BLAS_GUARD_FROM
         self._check_every_vertex_used()
         if actuation not in ACTUATIONS:
             raise SimulationError(f"unknown actuation {actuation!r} (available: "
@@ -421,15 +432,23 @@ class Simulation:
     def step(self) -> float:
         """One iteration of the strategy; returns the largest vertex displacement (mm).
 
-        With more than one numba thread, BLAS runs on one thread meanwhile
+        With more than one numba thread, or vectors long enough for BLAS to
+        thread them (``BLAS_GUARD_FROM``), BLAS runs on one thread meanwhile
         (:mod:`foldcore.threads`).
         """
-        with blas_on_one_thread(self.threads > 1):
+        with blas_on_one_thread(self._guard_blas):
             return self._step()
 
     def _step(self) -> float:
-        numba.set_num_threads(self.threads)
-        energy, moved = self.strategy.step()
+        if self._chooser is None:
+            numba.set_num_threads(self.threads)
+            energy, moved = self.strategy.step()
+        else:
+            threads = self._chooser.next()
+            numba.set_num_threads(threads)
+            start = time.perf_counter()
+            energy, moved = self.strategy.step()
+            self._chooser.record(threads, time.perf_counter() - start)
         self.energy_history.append(energy)
         self.iterations += 1
         if self._monitor is not None and self.solver == "paper":
@@ -519,7 +538,7 @@ class Simulation:
         budget, limit = int(max_iterations), tolerance * self.length_scale
         reason = "budget"  # unless the (released) stage ends otherwise
         self.equilibrium.begin_run()
-        with blas_on_one_thread(self.threads > 1):
+        with blas_on_one_thread(self._guard_blas):
             if self._starts_flat():
                 used, branch = self._branch_stage(budget, callback, limit)
                 budget -= used

@@ -67,3 +67,71 @@ def _one_blas_thread(refresh: bool):
             if _depth == 0:
                 _limiter.restore_original_limits()
                 _limiter = None
+
+
+class ThreadChooser:
+    """Numba threads per step for a simulation whose count the user did not fix:
+    the faster of one thread and ``most``, by the steps' own times.
+
+    On a quiet machine the parallel projection is faster from a few hundred
+    element-vertex slots on; on a shared one, a parallel loop waits at its end
+    for a thread the scheduler took away, so a step can cost a time slice
+    (issue 17, ``bench/load.py``: a paper step of a Miura 4 × 4 at the 95th
+    percentile 48 ms instead of 0.17 ms with two CPU-bound competitors).
+    Now and then one step runs with the other count: after ``EXPLORE_EVERY``
+    steps, an interval that doubles (up to ``EXPLORE_MOST``) each time the
+    other count was still the slower, so a loaded machine pays for few
+    parallel probes; each count's cost is the median of its last ``WINDOW``
+    step times (a probe's time alone for the probed count: its older ones ran
+    under another load), and the cheaper one runs the others (the parallel
+    count until the serial one has been timed). The choice follows the load
+    as it changes.
+    """
+
+    EXPLORE_EVERY = 16
+    EXPLORE_MOST = 512
+    WINDOW = 7
+
+    def __init__(self, most: int):
+        self.most = int(most)
+        self._times = {1: [], self.most: []}
+        self._interval = self.EXPLORE_EVERY
+        self._until = self.EXPLORE_EVERY  # steps to the next probe of the other count
+        self._probing = None  # the count a probe step is running with
+
+    def next(self) -> int:
+        """The thread count for the next step (call :meth:`record` after it)."""
+        if self.most == 1:
+            return 1
+        best = self.best()
+        self._until -= 1
+        if self._until <= 0:
+            self._probing = 1 if best == self.most else self.most
+            return self._probing
+        return best
+
+    def best(self) -> int:
+        """The count whose recent steps were cheaper (``most`` until both are timed)."""
+        serial, parallel = self._times[1], self._times[self.most]
+        if not serial or not parallel:
+            return self.most
+        return 1 if _median(serial) < _median(parallel) else self.most
+
+    def record(self, threads: int, seconds: float) -> None:
+        """The wall time of a step run with ``threads`` (a probe's replaces that count's
+        history: its earlier steps ran under another load)."""
+        times = self._times[threads]
+        if self._probing is not None:
+            times.clear()
+        times.append(float(seconds))
+        del times[:-self.WINDOW]
+        if self._probing is not None:  # back off while the probed count stays slower
+            lost = self.best() != self._probing
+            self._interval = min(2 * self._interval, self.EXPLORE_MOST) if lost \
+                else self.EXPLORE_EVERY
+            self._until, self._probing = self._interval, None
+
+
+def _median(values: list) -> float:
+    ordered = sorted(values)
+    return ordered[len(ordered) // 2]
