@@ -95,9 +95,10 @@ def run_summary(result, pattern, source: str, fold_percent: float) -> tuple[str,
         missed = entries["missed"]
         warns.append(f"{source}: converged, but {missed} of {driven} driven creases miss "
                      f"their targets by more than {MISS_WARNING_DEG:g}° (up to {worst:.3g}°): "
-                     "the model binds there — with rigid panels this pattern cannot reach "
-                     "these angles; the report's actuation lists each crease (README: "
-                     "patterns that are not rigidly foldable)")
+                     "the model binds there — these targets cannot all be met at once "
+                     "(with rigid panels: a pattern that is not rigidly foldable); the "
+                     "report's actuation lists each crease (README: Files made for "
+                     "Origami Simulator)")
     return line, warns
 
 
