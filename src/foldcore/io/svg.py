@@ -54,6 +54,9 @@ SNAP_MAX = 1e-2
 #: A Bézier or arc segment is straight if its points are off its chord by at most this
 #: share of the chord (Illustrator exports round coordinates to 1e-3 px).
 STRAIGHT = 1e-4
+#: A piece lies along a segment if the sine of the angle between them is at most this
+#: (a piece near a crossing is near both segments but along one).
+PARALLEL = 0.1
 #: Stroke (r, g, b) → (assignment, sign of the target: -1 mountain, +1 valley, 0 none).
 STROKES = {(0, 0, 0): ("B", 0.0), (255, 0, 0): ("M", -1.0), (0, 0, 255): ("V", 1.0),
            (255, 255, 0): ("F", 0.0), (255, 0, 255): ("U", 0.0), (0, 255, 0): ("C", 0.0)}
@@ -241,8 +244,12 @@ def _snap_endpoints(segments: np.ndarray, tol: float) -> np.ndarray:
 
 
 def _piece_types(pieces, edges, vertices, segments, kinds, angles, owners, tol, source):
-    """Each piece's assignment and target: those of the segments it lies on (its
-    midpoint within ``tol``); two different ones are refused."""
+    """Each piece's assignment and target: those of the segments it lies along — its
+    midpoint within ``tol`` and both ends within 2 ``tol`` of the segment, and its
+    direction within ``PARALLEL`` (sine) of the segment's; two different ones are
+    refused. A piece near a crossing is also near the crossing segment but not along
+    it; a short piece whose merged ends turned it by more is typed by the segment
+    closest to its direction, one whose ends merged farther by the nearest segment."""
     import shapely
 
     lines = shapely.linestrings(segments)
@@ -253,17 +260,34 @@ def _piece_types(pieces, edges, vertices, segments, kinds, angles, owners, tol, 
     along = np.maximum(shapely.distance(shapely.points(ends[piece_ids, 0]), lines[seg_ids]),
                        shapely.distance(shapely.points(ends[piece_ids, 1]), lines[seg_ids]))
     piece_ids, seg_ids = piece_ids[along <= 2.0 * tol], seg_ids[along <= 2.0 * tol]
+    sine = np.abs(_cross(_unit(ends[piece_ids, 1] - ends[piece_ids, 0]),
+                         _unit(segments[seg_ids, 1] - segments[seg_ids, 0])))
     assignment = np.full(len(pieces), "", dtype="<U1")
     target = np.full(len(pieces), np.nan)
     owner = [None] * len(pieces)
-    for p, s in zip(piece_ids, seg_ids):
-        same = assignment[p] == kinds[s] and (np.isnan(target[p]) and np.isnan(angles[s])
-                                              or target[p] == angles[s])
-        if owner[p] is None:
-            assignment[p], target[p], owner[p] = kinds[s], angles[s], owners[s]
-        elif not same:
-            raise PatternError(f"{source}: {owners[s]} and {owner[p]} overlap with "
-                               f"different crease types or angles ({kinds[s]} and "
-                               f"{assignment[p]}) near ({vertices[edges[p, 0]][0]:g}, "
-                               f"{-vertices[edges[p, 0]][1]:g}) px")
+    for p in np.unique(piece_ids):
+        mine = np.flatnonzero(piece_ids == p)
+        parallel = mine[sine[mine] <= PARALLEL]
+        chosen = parallel if len(parallel) else mine[[int(np.argmin(sine[mine]))]]
+        for s in seg_ids[chosen]:
+            same = assignment[p] == kinds[s] and (np.isnan(target[p]) and np.isnan(angles[s])
+                                                  or target[p] == angles[s])
+            if owner[p] is None:
+                assignment[p], target[p], owner[p] = kinds[s], angles[s], owners[s]
+            elif not same:
+                raise PatternError(f"{source}: {owners[s]} and {owner[p]} overlap with "
+                                   f"different crease types or angles ({kinds[s]} and "
+                                   f"{assignment[p]}) near ({vertices[edges[p, 0]][0]:g}, "
+                                   f"{-vertices[edges[p, 0]][1]:g}) px")
+    for p in [q for q, o in enumerate(owner) if o is None]:  # its ends merged far off
+        s = int(tree.query_nearest(shapely.points(ends[p].mean(axis=0)))[0])
+        assignment[p], target[p] = kinds[s], angles[s]
     return assignment.tolist(), [None if np.isnan(t) else float(t) for t in target]
+
+
+def _unit(d: np.ndarray) -> np.ndarray:
+    return d / np.maximum(np.hypot(d[:, 0], d[:, 1]), 1e-300)[:, None]
+
+
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
