@@ -41,3 +41,28 @@ def test_predict_needs_two_converged_runs_and_a_finite_ratio():
         sim.predict(np.nan)
     lbfgs = Simulation(thicken(pattern, 0.02), pattern, solver="lbfgs")
     assert lbfgs.predict(1.0) is False  # only the rigid-body strategies keep ends
+
+
+def test_a_sweep_from_flat_selects_its_branch_once():
+    """The branch stage (passive M/V creases held on their side) ran at every frame
+    while the sheet was within the 2° floor, though the first frame had chosen the
+    branch: a thin Miura 8 × 8 swept in 0.5 % steps spent 35, 17, 8, 4, 4, 4, 4 of
+    its first frames' 44, 26, 18, 14, 11, 8, 8 steps there. Now only the first frame
+    runs it, and every frame still lands on the fold a single run reaches."""
+    pattern = patterns.miura_one_crease(8, 8, a=20.0, b=20.0, width=0.06)
+    mesh = thicken(pattern, 0.02)
+    sim = Simulation(mesh, pattern)
+    staged, steps = [], []
+    for percent in (0.5, 1.0, 1.5, 2.0, 2.5):
+        before, branch = sim.iterations, sim.branch_iterations
+        sim.set_fold_percent(percent)
+        result = sim.run(tolerance=1e-8)
+        assert result.converged
+        staged.append(sim.branch_iterations - branch)
+        steps.append(sim.iterations - before)
+    assert staged[0] > 0 and staged[1:] == [0, 0, 0, 0]
+    assert max(steps[1:]) <= 6  # measured 4 each
+    alone = Simulation(mesh, pattern)
+    alone.set_fold_percent(2.5)
+    np.testing.assert_allclose(result.fold_angles_deg, alone.run(tolerance=1e-8)
+                               .fold_angles_deg, atol=1e-5)

@@ -26,8 +26,9 @@ take the wrong branch. A run that starts from a flat sheet (every crease
 within the floor of 0°) with a crease driven and passive M/V creases first
 folds with every passive M/V crease held at least ``BRANCH_FLOOR_DEG`` on its
 assigned side, to a relative step of ``BRANCH_TOLERANCE``, then releases the
-floor and runs to its own tolerance; from a folded state there is no such
-stage. Measured (bench/branch.py, default strategy): with the axis hinge
+floor and runs to its own tolerance; from a folded state, or one already on
+its branch (every passive M/V crease at least ``BRANCH_LEFT_DEG`` = 1e-3° on
+its side: a sweep's later frames), there is no such stage. Measured (bench/branch.py, default strategy): with the axis hinge
 every vertex (3 sector sets, both modes) and Miura sheet folds onto its
 assigned branch with or without the stage, but a thick Miura 10 × 10
 (H = 0.1 a, W = H, one crease driven) takes 662 iterations (53 s) without
