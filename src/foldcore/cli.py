@@ -258,12 +258,12 @@ def run_scene(args) -> int:
 def simulate(args) -> int:
     """Run ``foldcore simulate`` (:func:`foldcore.job.fold`); raises FoldcoreError on
     bad input."""
-    from .job import Interrupted, fold
+    from .job import Interrupted, defaults, fold
 
     progress = _progress(args)
+    options = {name: getattr(args, name) for name in defaults() if name != "callback"}
     try:
-        done = fold(args.pattern, callback=progress,
-                    **{name: getattr(args, name) for name in _SIMULATE_OPTIONS})
+        done = fold(args.pattern, callback=progress, **options)
     except Interrupted as stop:
         written = ", ".join(f"{k} {v}" for k, v in stop.written.items())
         print(f"foldcore: interrupted (SIGINT) after {stop.result.iterations} iterations; "
@@ -321,13 +321,6 @@ def _progress(args):
         return _Progress(args.max_iterations, args.tolerance)
     except ImportError:  # tqdm is a dependency; a stripped install runs without a bar
         return None
-
-
-#: ``simulate`` options passed to :func:`foldcore.job.fold` under their own names.
-_SIMULATE_OPTIONS = ("thickness", "hinge_width", "subdivisions", "fold_percent", "solver",
-                     "tolerance", "max_iterations", "hinge", "actuation", "branch_floor",
-                     "hinges", "mv_passive", "trust_assignment", "scale", "sheet_size",
-                     "output", "report", "render", "animate", "series", "frames", "fps")
 
 
 def _why(result) -> str:

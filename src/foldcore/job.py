@@ -195,16 +195,22 @@ def fold(path, **options) -> Fold:
     return Fold(loaded.pattern, mesh, sim, result, settings, summary)
 
 
-def _with_defaults(options: dict) -> dict:
-    """``options`` over :func:`simulate`'s defaults; an unknown name is a TypeError."""
+def defaults() -> dict:
+    """:func:`simulate`'s options (its keyword-only parameters) and their defaults; the
+    command line passes its own arguments of these names."""
     import inspect
 
-    defaults = {name: p.default for name, p in inspect.signature(simulate).parameters.items()
-                if p.kind is p.KEYWORD_ONLY}
-    unknown = set(options) - set(defaults)
+    return {name: p.default for name, p in inspect.signature(simulate).parameters.items()
+            if p.kind is p.KEYWORD_ONLY}
+
+
+def _with_defaults(options: dict) -> dict:
+    """``options`` over :func:`simulate`'s defaults; an unknown name is a TypeError."""
+    known = defaults()
+    unknown = set(options) - set(known)
     if unknown:
         raise TypeError(f"simulate() got unexpected options {sorted(unknown)}")
-    return {**defaults, **options}
+    return {**known, **options}
 
 
 def _animate(sim, o: dict) -> list:

@@ -37,12 +37,18 @@ def series_frame(mesh, result, percent: float) -> dict:
     frame = folded_frame(mesh, result.positions)
     targets = result.target_angles_deg
     frame.update({"frame_title": f"fold percent {percent:g}", SERIES_PERCENT_KEY: percent,
-                  SERIES_ANGLE_KEY: _nullable(np.clip(result.fold_angles_deg, -180.0, 180.0)),
+                  SERIES_ANGLE_KEY: _nullable(in_fold_range(result.fold_angles_deg)),
                   SERIES_TARGET_KEY: None if targets is None else _nullable(targets),
                   "foldcore:converged": bool(result.converged),
                   "foldcore:reason": result.reason,
                   "foldcore:iterations": int(result.iterations)})
     return frame
+
+
+def in_fold_range(angles) -> np.ndarray:
+    """Achieved angles (degrees) as a FOLD file holds them: within [−180°, 180°] (a
+    crease past flat on its assigned side, −180.54°, is written −180°)."""
+    return np.clip(angles, -180.0, 180.0)
 
 
 def _nullable(values) -> list:
@@ -263,10 +269,10 @@ def write_result(result, pattern, mesh, thickness: float, settings: dict, *, fol
                          "series": series}) as tmp:
         if series:
             from .io import write_fold
-            write_fold(tmp["series"], pattern, achieved_angles=np.clip(
-                result.fold_angles_deg, -180.0, 180.0),
-                frames=[series_frame(mesh, r, p) for p, r in sweep], thickness=thickness,
-                extra=_mesh_recipe(pattern, mesh))
+            write_fold(tmp["series"], pattern,
+                       achieved_angles=in_fold_range(result.fold_angles_deg),
+                       frames=[series_frame(mesh, r, p) for p, r in sweep],
+                       thickness=thickness, extra=_mesh_recipe(pattern, mesh))
         if png and picture is not None:
             import imageio.v3 as iio
             iio.imwrite(tmp["png"], picture, extension=".png")
@@ -277,8 +283,8 @@ def write_result(result, pattern, mesh, thickness: float, settings: dict, *, fol
             from .io import write_fold
             extra = {**(_mesh_recipe(pattern, mesh) or {}),
                      **({PARTIAL_KEY: True} if partial else {})}
-            write_fold(tmp["fold"], pattern, achieved_angles=np.clip(  # FOLD's range
-                result.fold_angles_deg, -180.0, 180.0),
+            write_fold(tmp["fold"], pattern,
+                       achieved_angles=in_fold_range(result.fold_angles_deg),
                        frames=[folded_frame(mesh, result.positions)], thickness=thickness,
                        extra=extra or None)
         if report:

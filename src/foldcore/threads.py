@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import threading
 from contextlib import contextmanager, nullcontext
+from statistics import median_low
 
 # threadpoolctl.ThreadpoolController, built on first use: by then a Simulation
 # exists, and building one loads numpy's and scipy's BLAS (checked)
@@ -115,7 +116,7 @@ class ThreadChooser:
         serial, parallel = self._times[1], self._times[self.most]
         if not serial or not parallel:
             return self.most
-        return 1 if _median(serial) < _median(parallel) else self.most
+        return 1 if median_low(serial) < median_low(parallel) else self.most
 
     def record(self, threads: int, seconds: float) -> None:
         """The wall time of a step run with ``threads`` (a probe's replaces that count's
@@ -131,7 +132,3 @@ class ThreadChooser:
                 else self.EXPLORE_EVERY
             self._until, self._probing = self._interval, None
 
-
-def _median(values: list) -> float:
-    ordered = sorted(values)
-    return ordered[len(ordered) // 2]
