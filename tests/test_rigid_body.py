@@ -112,3 +112,32 @@ def test_cli_solver_option(tmp_path):
     assert abs(data["fold_angles_deg"][0] - 90.0) < 0.01
     assert set(data["timings_s"]) >= {"setup", "projection", "solve", "total"}
     assert main(["simulate", str(src), "--solver", "newton"]) == 2
+
+
+@pytest.mark.parametrize("accepted, ratio, factor", [
+    (True, 1.0, 1 / 3),           # the model was exact: λ falls by LAMBDA_DOWN
+    (True, 0.5, 1.0),             # half right: λ stays
+    (True, 0.0, 2.0),             # no gain although accepted: λ doubles
+    (True, float("nan"), 1.0),    # predicted decrease rounded to 0: no verdict
+    (False, -10.0, 5.0),          # rejected: × LAMBDA_UP, whatever ρ
+])
+def test_damping_follows_the_gain_ratio(accepted, ratio, factor):
+    from foldcore.rigid_body import LAMBDA_DOWN, LAMBDA_UP
+
+    assert (LAMBDA_DOWN, LAMBDA_UP) == (3.0, 5.0)  # the factors of the table above
+    pattern, mesh = long_hinge(5)
+    engine = Simulation(mesh, pattern, solver="rigid").strategy.engine
+    engine.lam, engine.accepted, engine.gain_ratio = 1e-6, accepted, ratio
+    engine._update_damping()
+    assert engine.lam == pytest.approx(1e-6 * factor, rel=1e-12)
+
+
+def test_a_step_reports_its_gain_ratio_and_damped_share():
+    pattern, mesh = thin_vertex()
+    sim = Simulation(mesh, pattern, solver="rigid")
+    engine = sim.strategy.engine
+    for _ in range(5):
+        sim.step()
+        assert 0.0 <= engine.damped_share <= 1.0  # ‖Jv‖² and 2λvᵀDv are both ≥ 0
+        if engine.accepted:  # E fell, the model predicted a fall: ρ ≥ 0
+            assert engine.gain_ratio >= 0.0
