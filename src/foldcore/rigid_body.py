@@ -147,6 +147,7 @@ class RigidBodySolver:
         self._init_mv_sides(mesh, sim.pattern)
         self.lam = LAMBDA_START
         self.accepted, self.energy, self.decrease = False, np.inf, np.inf  # the last step's
+        self.gain_ratio, self.damped_share = np.nan, 0.0  # the last step's (step)
         self.energy_scale = 0.0
         self._passive = None
         self._pinned = False
@@ -754,7 +755,7 @@ class RigidBodySolver:
         thin Miura the step length cycled (accepted at ρ ≈ 1, accepted at
         ρ ≈ 0.4, rejected at ρ ≈ −10 …), a rejected step — a full factorisation
         — every third iteration; measured (hybrid, tolerance 1e-8): thin Miura
-        10 × 10 71 → 53 iterations, 20 × 20 100 → 66, 8 × 8 66 → 44, Pehrson's
+        10 × 10 71 → 52 iterations, 20 × 20 100 → 67, 8 × 8 66 → 44, Pehrson's
         vertex (W = 3H, H/R = 1e-3, mode A) 36 → 29, waterbomb 52 → 44; the
         thick mode-B vertex (H/R = 0.1) 81 → 82. Why not Nielsen's doubling
         factor after rejections: a kink in E (a bound, an M/V side row) rejects
