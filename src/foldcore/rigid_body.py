@@ -726,11 +726,13 @@ class RigidBodySolver:
         moved = float(np.abs(trial.x - self.x).max())
         new_energy = self._trial_energy(trial)
         self.accepted, self.step_lam = new_energy <= energy, self.lam
-        predicted = -2.0 * float(grad @ velocity) - float(j_velocity @ j_velocity)
-        # the model's decrease is ‖Jv‖² + 2λ vᵀDv > 0; ≤ 0 only by rounding (no verdict)
-        self.gain_ratio = (energy - new_energy) / predicted if predicted > 0 else np.nan
-        self.damped_share = (1.0 - float(j_velocity @ j_velocity) / predicted
-                             if predicted > 0 else 0.0)
+        model = float(j_velocity @ j_velocity)  # ‖Jv‖²
+        predicted = -2.0 * float(grad @ velocity) - model  # = ‖Jv‖² + 2λ vᵀDv
+        if predicted > 0:
+            self.gain_ratio = (energy - new_energy) / predicted
+            self.damped_share = 1.0 - model / predicted
+        else:  # ≤ 0 only by rounding: no verdict on the model
+            self.gain_ratio, self.damped_share = np.nan, 0.0
         if self.accepted:
             self._set_state(trial)
         else:
