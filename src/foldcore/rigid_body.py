@@ -640,7 +640,7 @@ class RigidBodySolver:
             self.crease_ptr, self.crease_strips, self.csc_indptr, self.csc_indices, data, lin.grad)
         if lin.extra is not None:
             lin.grad += lin.extra.T @ residual[24 * s:]
-            coo = (lin.extra.T @ lin.extra).tocoo()
+            coo = sp.tril(lin.extra.T @ lin.extra, format="coo")  # the stored triangle
             missing += rigid_normal.add_entries(self.csc_indptr, self.csc_indices, data,
                                                 coo.row.astype(np.int64),
                                                 coo.col.astype(np.int64), coo.data)
@@ -879,7 +879,7 @@ class RigidBodySolver:
         n = self.n_unknowns
         matrix = sp.csc_matrix((values, self.csc_indices, self.csc_indptr), shape=(n, n))
         if self._normal_factor is None:
-            self._normal_factor = Factor(matrix, self.backend)
+            self._normal_factor = Factor(matrix, self.backend, stored="lower")
         else:
             self._normal_factor.refactor(matrix)
         return self._normal_factor
