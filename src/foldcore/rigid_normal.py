@@ -174,7 +174,8 @@ def assemble(ids, x, c_p, side, off_panel, alpha, own_off, off_w, off_phi, loc_c
 @njit(cache=True)
 def _strip_normal(s, ids, x, c_p, side, off_panel, alpha, own_off, off_w, off_phi, nl,
                   sqrt_w, targets, d_targets, residual, local, g_loc, work, index):
-    """Strip s's JᵀJ into ``local`` (nl, nl) and Jᵀr into ``g_loc`` (nl,), overwritten;
+    """Strip s's JᵀJ, its lower triangle (row ≥ column; the upper one is left
+    undefined), into ``local`` (nl, nl) and Jᵀr into ``g_loc`` (nl,), overwritten;
     ``work`` (22, MAX_LOCAL) float and ``index`` (19,) int are scratch."""
     gbar = work[0:3]
     vecs = work[3:18, 0:3]
@@ -201,19 +202,23 @@ def _strip_normal(s, ids, x, c_p, side, off_panel, alpha, own_off, off_w, off_ph
         for i in range(n):
             ci = cols[i]
             vi0, vi1, vi2 = vecs[i, 0], vecs[i, 1], vecs[i, 2]
-            for j in range(n):
-                local[ci, cols[j]] += w * (vi0 * vecs[j, 0] + vi1 * vecs[j, 1] + vi2 * vecs[j, 2])
-            for j in range(n_e):  # Σ_k G_kᵀ E_k √w
-                value = sw * (vi0 * evecs[j, 0] + vi1 * evecs[j, 1] + vi2 * evecs[j, 2])
-                local[ci, ecols[j]] += value
-                local[ecols[j], ci] += value
+            for j in range(i + 1):  # one triangle: the lower one is stored
+                cj = cols[j]
+                value = w * (vi0 * vecs[j, 0] + vi1 * vecs[j, 1] + vi2 * vecs[j, 2])
+                if ci >= cj:
+                    local[ci, cj] += value
+                else:
+                    local[cj, ci] += value
+            for j in range(n_e):  # Σ_k G_kᵀ E_k √w (E's columns come after G's)
+                local[ecols[j], ci] += sw * (vi0 * evecs[j, 0] + vi1 * evecs[j, 1]
+                                             + vi2 * evecs[j, 2])
             gbar[0, ci] += 0.125 * vi0
             gbar[1, ci] += 0.125 * vi1
             gbar[2, ci] += 0.125 * vi2
             g_loc[ci] += sw * (vi0 * r0 + vi1 * r1 + vi2 * r2)
         for i in range(n_e):
             ci = ecols[i]
-            for j in range(n_e):
+            for j in range(i + 1):  # ecols increasing
                 local[ci, ecols[j]] += (evecs[i, 0] * evecs[j, 0] + evecs[i, 1] * evecs[j, 1]
                                         + evecs[i, 2] * evecs[j, 2])
             for d in range(3):
@@ -224,12 +229,10 @@ def _strip_normal(s, ids, x, c_p, side, off_panel, alpha, own_off, off_w, off_ph
         gi0, gi1, gi2 = gbar[0, i], gbar[1, i], gbar[2, i]
         if gi0 == 0.0 and gi1 == 0.0 and gi2 == 0.0:
             continue
-        for j in range(n_pos):
+        for j in range(i + 1):
             local[i, j] -= 8.0 * w * (gi0 * gbar[0, j] + gi1 * gbar[1, j] + gi2 * gbar[2, j])
         for j in range(n_e):  # − Ḡᵀ Σ_k E_k √w
-            value = sw * (gi0 * ebar[0, j] + gi1 * ebar[1, j] + gi2 * ebar[2, j])
-            local[i, ecols[j]] -= value
-            local[ecols[j], i] -= value
+            local[ecols[j], i] -= sw * (gi0 * ebar[0, j] + gi1 * ebar[1, j] + gi2 * ebar[2, j])
         g_loc[i] -= sw * (gi0 * rsum[0] + gi1 * rsum[1] + gi2 * rsum[2])
 
 
