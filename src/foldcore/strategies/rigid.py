@@ -49,7 +49,7 @@ class Rigid(Strategy):
         (:meth:`RigidBodySolver.settled`): a stall does not end a run. A settled
         state is kept for :meth:`predict`."""
         done = self.engine.settled(moved, limit / self.sim.length_scale)
-        self.sim.equilibrium.residual = moved / self.sim.length_scale  # its Newton step
+        self.sim.equilibrium.residual = self.engine.distance_left(moved) / self.sim.length_scale
         if done:
             self.engine.record_end()
         return done
