@@ -21,12 +21,17 @@ def best_rotations(covs: np.ndarray) -> np.ndarray:
 
 
 def element_rotations(group, positions: np.ndarray) -> np.ndarray:
-    """(n, 3, 3) best-fit rotation of each element's rest shape onto its current shape."""
-    covs = np.zeros((len(group), 3, 3))
-    for e in range(len(group)):
-        s = group.slots(e)
-        p = positions[group.indices[s]]
-        covs[e] = (p - p.mean(axis=0)).T @ group.rest[s]
+    """(n, 3, 3) best-fit rotation of each element's rest shape onto its current shape.
+
+    All elements at once (segment sums over the slots): a Python loop over the
+    panels cost a 200-frame fold-percent path of a Miura 8 × 8 0.8 s of its 8.5 s
+    (two fold-angle measurements per frame)."""
+    starts = group.indptr[:-1]
+    sizes = np.diff(group.indptr)
+    p = positions[group.indices]
+    means = np.add.reduceat(p, starts, axis=0) / sizes[:, None]
+    centred = p - np.repeat(means, sizes, axis=0)
+    covs = np.add.reduceat(centred[:, :, None] * group.rest[:, None, :], starts, axis=0)
     return best_rotations(covs)
 
 

@@ -456,8 +456,11 @@ class RigidBodySolver:
             cols.append(padded)
             n_loc.append(np.full(len(block), size, dtype=np.int64))
             kind.append(np.full((len(block), width), -1, dtype=np.int64))
-        self.csc_indptr, self.csc_indices = rigid_normal.pattern_csc(
+        indptr, indices = rigid_normal.pattern_csc(
             np.concatenate(n_loc), np.concatenate(cols), np.concatenate(kind), n)
+        # 32-bit indices, as CHOLMOD's int interface and SciPy take them: no copy per step
+        index = np.int32 if indptr[-1] < np.iinfo(np.int32).max else np.int64
+        self.csc_indptr, self.csc_indices = indptr.astype(index), indices.astype(index)
         column = np.repeat(np.arange(n), np.diff(self.csc_indptr))
         self.diag_slot = np.flatnonzero(self.csc_indices == column)
         self._normal_factor = None
@@ -899,8 +902,9 @@ class RigidBodySolver:
         return moved
 
     def _factor(self, normal: np.ndarray, grad) -> Factor:
-        """Factorisation of JᵀJ + λ·diag(JᵀJ) (values ``normal`` on the fixed pattern),
-        angles on a bound they press against frozen; the symbolic analysis is reused."""
+        """Factorisation of JᵀJ + λ·diag(JᵀJ) (values ``normal`` on the fixed pattern,
+        damped in place), angles on a bound they press against frozen; the symbolic
+        analysis is reused."""
         diag = normal[self.diag_slot]
         diag = np.maximum(diag, 1e-12 * max(diag.max(), 1e-300))
         folds = self._folds(self.phi)
@@ -909,10 +913,9 @@ class RigidBodySolver:
                   ((folds >= self.hi - BOUND_TOL) & (g_fold < 0))
         damping = self.lam * diag
         damping[self.phi_col:][blocked] = 1e12 * diag[self.phi_col:][blocked]
-        values = normal.copy()
-        values[self.diag_slot] += damping
+        normal[self.diag_slot] += damping  # in place: the step needs the undamped no more
         n = self.n_unknowns
-        matrix = sp.csc_matrix((values, self.csc_indices, self.csc_indptr), shape=(n, n))
+        matrix = sp.csc_matrix((normal, self.csc_indices, self.csc_indptr), shape=(n, n))
         if self._normal_factor is None:
             self._normal_factor = Factor(matrix, self.backend, stored="lower")
         else:
