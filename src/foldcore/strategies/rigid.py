@@ -49,7 +49,10 @@ class Rigid(Strategy):
         (:meth:`RigidBodySolver.settled`): a stall does not end a run. A settled
         state is kept for :meth:`predict`."""
         done = self.engine.settled(moved, limit / self.sim.length_scale)
-        self.sim.equilibrium.residual = self.engine.distance_left(moved) / self.sim.length_scale
+        self.sim.x = self.engine.x  # a simplified correction may have moved it
+        if self.sim._hinges is not None:
+            self.sim._hinges.state[:, 0] = self.engine.phi
+        self.sim.equilibrium.residual = self.engine.distance / self.sim.length_scale
         if done:
             self.engine.record_end()
         return done
