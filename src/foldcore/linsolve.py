@@ -53,7 +53,7 @@ class Factor:
         either way (scikit-sparse passes it as stype −1), so a lower-only
         matrix gives the same factor from half the memory, as fast (the
         rigid-body normal matrix of a thin Miura 20 × 20, 39 633 rows, six
-        interleaved refactorisations, 2-core EPYC guest, 2026-12-02: medians
+        interleaved refactorisations, 2-core Xeon guest, 2026-12-02: medians
         33 vs 32 ms; 50 × 50, 255 093 rows: 294 vs 332 ms). SciPy's LU needs
         both: it is mirrored there.
     """
