@@ -844,8 +844,10 @@ class RigidBodySolver:
 
     def settled(self, moved: float, tolerance: float) -> bool:
         """Whether the last step ends a run at relative ``tolerance``: it was accepted,
-        moved ≤ tolerance × the pattern's size, and lowered the energy by ≤ tolerance
-        × the energy, and the damping was neither large (λ ≤ ``LAMBDA_SETTLED``)
+        the distance it leaves (:meth:`distance_left`: the step's length, or a bound
+        from its contraction) is ≤ tolerance × the pattern's size, it lowered the
+        energy by ≤ tolerance × the energy (or left no more than that), and the
+        damping was neither large (λ ≤ ``LAMBDA_SETTLED``)
         nor the main part of the decrease the model predicted for it
         (``damped_share`` = 2λvᵀDv / (‖Jv‖² + 2λvᵀDv) ≤ ``DAMPED_SHARE_MAX``):
         a step short because λ held it back says nothing about the equilibrium.
@@ -874,23 +876,27 @@ class RigidBodySolver:
         minimum no step can lower, e.g. the chain scene pushed against its stop,
         where the energy has a kink (34 rejected steps from λ = 1e-4 to get there).
         """
-        if self.distance_left(moved, tolerance * self.sim.length_scale) > \
-                tolerance * self.sim.length_scale:
-            return False
+        limit = tolerance * self.sim.length_scale
         floor = tolerance ** 2 * self.energy_scale + self._rounding_energy()
         if self.accepted:  # a step damped to a crawl says nothing: λ must be small
+            quiet = self.step_lam <= LAMBDA_SETTLED and self.damped_share <= DAMPED_SHARE_MAX
+            energy_limit = tolerance * self.energy + floor
+            if self.distance_left(moved, limit, energy_limit if quiet else None) > limit:
+                return False
             left = self.energy - self.decrease  # ≥ any later decrease
-            return bool(min(self.decrease, left) <= tolerance * self.energy + floor
-                        and self.step_lam <= LAMBDA_SETTLED
-                        and self.damped_share <= DAMPED_SHARE_MAX)
+            return bool(min(self.decrease, left) <= energy_limit and quiet)
+        if self.distance_left(moved, limit) > limit:
+            return False
         # rejected: at the energy's rounding floor, or no descent at any damping
         return bool(self.energy <= floor or -self.decrease <= ROUNDING * self.energy
                     or self.step_lam >= LAMBDA_MAX)
 
-    def distance_left(self, moved: float, limit: float) -> float:
+    def distance_left(self, moved: float, limit: float, energy_limit=None) -> float:
         """Estimated distance (mm) from the state after the last step (of largest
         vertex move ``moved`` mm) to the equilibrium, for a run whose limit is
-        ``limit`` mm; stored as ``distance``.
+        ``limit`` mm; stored as ``distance``. ``energy_limit`` (mm⁵, None: no
+        correction is tried): the largest energy decrease, or energy, that
+        ends the run (:meth:`settled`).
 
         After two accepted steps whose lengths contracted by Θ = ``contraction``
         ≤ ``CONTRACTION_MAX``, the steps still to come sum to ≤ Θ/(1 − Θ) × the
@@ -899,8 +905,9 @@ class RigidBodySolver:
         convergence of Gauss–Newton on compatible targets it overestimates).
         After a first accepted step within ``CHORD_FROM`` × the limit, the
         simplified correction (:meth:`_simplified_correction`) is tried: when it
-        lowers the energy, contracts and leaves a distance within the limit, it is
-        applied and its bound returned. Otherwise the step's own length,
+        lowers the energy to within ``energy_limit`` (or by no more than it),
+        contracts and leaves a distance within the limit — when it ends the run
+        — it is applied and its bound returned. Otherwise the step's own length,
         ``moved``: the distance before it.
         Why: a fold-percent path's frames (thin Miura 8 × 8, 0.5 % increments)
         took 3 steps each, a correction of ~1e-5 × the size, a second of
@@ -914,13 +921,14 @@ class RigidBodySolver:
         theta = self.contraction
         if self.accepted and theta <= CONTRACTION_MAX:
             self.distance = moved * theta / (1.0 - theta)
-        elif self.accepted and limit < moved <= CHORD_FROM * limit:
+        elif self.accepted and energy_limit is not None and limit < moved <= CHORD_FROM * limit:
             correction = self._simplified_correction()
             if correction is not None:
                 trial, energy, length = correction
                 theta = length / moved
                 left = length * theta / (1.0 - theta) if theta < 1.0 else np.inf
-                if theta <= CONTRACTION_MAX and left <= limit:
+                if (theta <= CONTRACTION_MAX and left <= limit
+                        and min(self.energy - energy, energy) <= energy_limit):
                     self._set_state(trial)
                     self.decrease = self.energy - energy
                     self.distance = left
