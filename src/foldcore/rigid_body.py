@@ -922,23 +922,21 @@ class RigidBodySolver:
         if self.accepted and theta <= CONTRACTION_MAX:
             self.distance = moved * theta / (1.0 - theta)
         elif self.accepted and energy_limit is not None and limit < moved <= CHORD_FROM * limit:
-            correction = self._simplified_correction()
-            if correction is not None:
-                trial, energy, length = correction
-                theta = length / moved
-                left = length * theta / (1.0 - theta) if theta < 1.0 else np.inf
-                if (theta <= CONTRACTION_MAX and left <= limit
-                        and min(self.energy - energy, energy) <= energy_limit):
-                    self._set_state(trial)
-                    self.decrease = self.energy - energy
-                    self.distance = left
-                else:
-                    self._update_shapes(self.phi)  # the kept state's shapes
+            trial, energy, length = self._simplified_correction()
+            theta = length / moved
+            left = length * theta / (1.0 - theta) if theta < 1.0 else np.inf
+            if (energy <= self.energy - self.decrease and theta <= CONTRACTION_MAX
+                    and left <= limit and min(self.energy - energy, energy) <= energy_limit):
+                self._set_state(trial)
+                self.decrease = self.energy - energy
+                self.distance = left
+            else:
+                self._update_shapes(self.phi)  # the kept state's shapes
         return self.distance
 
     def _simplified_correction(self):
         """(state, energy mm⁵, largest vertex move mm) of the simplified correction
-        at the current state, or None where it raises the energy; not applied.
+        at the current state; not applied.
 
         v̄ = −(JᵀJ + λD)⁻¹ Jᵀ r: the last step's factorisation and Jacobian, the
         residual here (one more solve, no factorisation; the simplified Newton
@@ -951,9 +949,6 @@ class RigidBodySolver:
         self.solve_time += time.perf_counter() - t0
         trial = self._apply(state, v)
         energy = self._trial_energy(trial)
-        if not energy <= self.energy - self.decrease:
-            self._update_shapes(self.phi)
-            return None
         return trial, energy, float(np.abs(trial.x - state.x).max())
 
     def _factor(self, normal: np.ndarray, grad) -> Factor:

@@ -28,16 +28,21 @@ class Rigid(Strategy):
         sim.x = self.engine.x
 
     def step(self) -> tuple[float, float]:
+        return self._engine_call(self.engine.step)
+
+    def _engine_call(self, call, *args):
+        """``call(*args)`` on the engine, its time added to the simulation's timings
+        (solve / the rest as projection) and its state handed to the simulation."""
         sim, engine = self.sim, self.engine
         t0, solve0 = time.perf_counter(), engine.solve_time
-        energy, moved = engine.step()
+        out = call(*args)
         sim.x = engine.x
         if sim._hinges is not None:
             sim._hinges.state[:, 0] = engine.phi
         solve = engine.solve_time - solve0
         sim.timings["solve"] += solve
         sim.timings["projection"] += time.perf_counter() - t0 - solve
-        return energy, moved
+        return out
 
     def begin_run(self) -> None:
         if self._run != self.sim.runs:  # a new Simulation.run, not its second stage
@@ -45,13 +50,11 @@ class Rigid(Strategy):
             self.engine.new_run()
 
     def settled(self, moved: float, limit: float) -> bool:
-        """An accepted step, small in length and in energy decrease
+        """An accepted step, small in the distance it leaves and in energy decrease
         (:meth:`RigidBodySolver.settled`): a stall does not end a run. A settled
-        state is kept for :meth:`predict`."""
-        done = self.engine.settled(moved, limit / self.sim.length_scale)
-        self.sim.x = self.engine.x  # a simplified correction may have moved it
-        if self.sim._hinges is not None:
-            self.sim._hinges.state[:, 0] = self.engine.phi
+        state is kept for :meth:`predict`. Timed and synced as a step: the test
+        may apply a simplified correction."""
+        done = self._engine_call(self.engine.settled, moved, limit / self.sim.length_scale)
         self.sim.equilibrium.residual = self.engine.distance / self.sim.length_scale
         if done:
             self.engine.record_end()
