@@ -842,6 +842,81 @@ class RigidBodySolver:
         self._fitted = False
         return True
 
+    @property
+    def laid_out(self) -> bool:
+        """Whether the unknowns' layout exists (built by the first step)."""
+        return self._passive is not None
+
+    def fold_edges(self) -> np.ndarray:
+        """(n_folds,) pattern edge of each passive crease's angle unknown."""
+        edges = np.zeros(self.n_folds, dtype=np.int64)
+        edges[self.passive_of] = self.hinges.group.source[self.passive_ids]
+        return edges
+
+    def folds(self) -> np.ndarray:
+        """(n_folds,) current bend of each passive crease, rad (order of :meth:`fold_edges`)."""
+        return self._folds(self.phi)
+
+    def adopt(self, rot_p, c_p, fold_of_edge, energy_scale: float = 0.0,
+              lam: float = LAMBDA_START) -> None:
+        """Continue from panels at rotations ``rot_p`` (P, 3, 3) and centroids ``c_p``
+        (P, 3) mm, passive creases bent by ``fold_of_edge`` (E,) rad (per pattern
+        edge; clamped to their intervals), hinge-interior vertices placed on their
+        strips' bent shapes (:meth:`place_interiors`): the state another model of
+        the same pattern reached (:mod:`foldcore.coarse`). ``energy_scale`` (mm⁵)
+        is the run's largest energy so far (:meth:`settled`), ``lam`` its damping."""
+        self._sync_weights()
+        self._read_targets()  # the column layout and the angles' intervals
+        self.rot_p, self.c_p = np.asarray(rot_p, float), np.asarray(c_p, float)
+        folds = np.asarray(fold_of_edge, float)[self.fold_edges()]
+        self._set_folds(np.clip(folds, self.lo, self.hi), self.phi)
+        self.y = self.place_interiors()
+        self.x = self._positions(self.rot_p, self.c_p, self.y)
+        self._fitted, self._ends = False, []
+        self.contraction, self._accepted_move = np.nan, None
+        self.energy_scale = max(self.energy_scale, float(energy_scale))
+        self.lam = min(float(lam), LAMBDA_START)
+
+    def place_interiors(self) -> np.ndarray:
+        """(n_free, 3) mm: hinge-interior vertices where the strips' bent shapes put
+        them, strip after strip across each crease from the panel its first strip
+        touches (each strip's known side — a panel's edge, then the line the strip
+        before placed — fitted rigidly to its bent shape, the other side taken from
+        it). Exact where the crease's strips meet its far panel too (arc and axis
+        hinges bent alike: one arc, :mod:`foldcore.coarse`); the steps correct the
+        rest. Vertices no chain reaches keep their current positions."""
+        self._update_shapes(self.phi)
+        shape = self.shape.reshape(-1, 8, 3)
+        x = self._positions(self.rot_p, self.c_p, self.y)
+        for batch, known, unknown in self._interior_chains():
+            ids, bent = self.ids[batch], shape[batch]
+            src, dst = (np.take_along_axis(ids, side, 1) for side in (known, unknown))
+            here = x[src]
+            t_src = np.take_along_axis(bent, known[:, :, None], 1)
+            t_dst = np.take_along_axis(bent, unknown[:, :, None], 1)
+            centre = t_src.mean(axis=1, keepdims=True)
+            rot = procrustes(here, t_src - centre)
+            x[dst] = np.einsum("nij,nkj->nki", rot, t_dst - centre) + here.mean(axis=1)[:, None]
+        return x[self.free]
+
+    def _interior_chains(self) -> list:
+        """[(strips (b,), known local vertices (b, 4), unknown ones (b, 4))] per place
+        in the creases' series of strips, for :meth:`place_interiors`; built once."""
+        if getattr(self, "_chains", None) is not None:
+            return self._chains
+        known = self.owner >= 0
+        chains = [np.asarray(c) for c in self.sim.mesh.strips_of_crease.values()]
+        self._chains = []
+        for j in range(max((len(c) for c in chains), default=1) - 1):
+            batch = np.array([c[j] for c in chains if len(c) > j + 1], dtype=np.int64)
+            mask = known[self.ids[batch]]
+            fit = mask.sum(axis=1) == 4  # a side known, the other to place
+            batch, mask = batch[fit], mask[fit]
+            order = np.argsort(~mask, axis=1, kind="stable")
+            self._chains.append((batch, order[:, :4], order[:, 4:]))
+            known[self.ids[batch]] = True
+        return self._chains
+
     def settled(self, moved: float, tolerance: float) -> bool:
         """Whether the last step ends a run at relative ``tolerance``: it was accepted,
         the distance it leaves (:meth:`distance_left`: the step's length, or a bound
@@ -887,9 +962,12 @@ class RigidBodySolver:
             return bool(min(self.decrease, left) <= energy_limit and quiet)
         if self.distance_left(moved, limit) > limit:
             return False
-        # rejected: at the energy's rounding floor, or no descent at any damping
+        # rejected: at the energy's rounding floor, no descent at any damping, or an
+        # undamped Gauss–Newton step within the limit that changed E by ≤ tolerance × E
+        quiet = self.step_lam <= LAMBDA_SETTLED and self.damped_share <= DAMPED_SHARE_MAX
         return bool(self.energy <= floor or -self.decrease <= ROUNDING * self.energy
-                    or self.step_lam >= LAMBDA_MAX)
+                    or self.step_lam >= LAMBDA_MAX
+                    or (quiet and -self.decrease <= tolerance * self.energy + floor))
 
     def distance_left(self, moved: float, limit: float, energy_limit=None) -> float:
         """Estimated distance (mm) from the state after the last step (of largest

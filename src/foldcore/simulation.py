@@ -267,6 +267,7 @@ class Simulation:
         self.branch_floor_deg = float(branch_floor_deg)
         self.branch_iterations = 0  # iterations spent in branch stages (run docstring)
         self.runs = 0  # calls of run so far (a run's stages share one number)
+        self.stage = None  # the stage of the run in progress: "branch", "run" or None
         self._targets = np.zeros((offset, 3))
         # column-major: CHOLMOD's own layout, so the solve copies nothing in
         self._rhs = np.zeros((mesh.n_vertices, 3), order="F")
@@ -542,13 +543,21 @@ class Simulation:
         reason = "budget"  # unless the (released) stage ends otherwise
         self.equilibrium.begin_run()
         with blas_on_one_thread(self._guard_blas):
-            if self._starts_flat():
-                used, branch = self._branch_stage(budget, callback, limit)
-                budget -= used
-                if branch == "callback":
-                    reason = branch
-            if budget > 0 and reason != "callback":
-                _, reason = self._stage(budget, callback, limit)
+            try:
+                if self._starts_flat():
+                    self.stage = "branch"
+                    used, branch = self._branch_stage(budget, callback, limit)
+                    budget -= used
+                    if branch == "callback":
+                        reason = branch
+                    self.stage = "run"
+                    if budget <= 0 or reason == "callback":
+                        self.strategy.end_run()  # no stage follows the branch stage
+                self.stage = "run"
+                if budget > 0 and reason != "callback":
+                    _, reason = self._stage(budget, callback, limit)
+            finally:
+                self.stage = None
         self.timings["total"] += time.perf_counter() - start
         self.timings["bare_solve"] = self._bare_solve_floor()
         return self.result(reason == "converged", reason)

@@ -82,10 +82,14 @@ class Hybrid(Strategy):
     def settled(self, moved: float, limit: float) -> bool:
         if self.rigid is None:
             return super().settled(moved, limit)
+        coarse = self.rigid.twin is not None
         done = self.rigid.settled(moved, limit)
+        if coarse and not done and self._rigid_steps < HYBRID_RIGID_MAX:
+            return False  # the twin's steps: it hands over itself when it stalls
         tiny = self.rigid.engine.accepted and moved <= HYBRID_RIGID_TOL * self.sim.length_scale
         if done or tiny or self._rigid_steps >= HYBRID_RIGID_MAX:
             if not done:  # L-BFGS takes over: the run will not end at a rigid state
+                self.rigid.hand_over()
                 self.rigid.engine.forget_ends()
             self._leave_rigid_phase()
         return done
@@ -97,6 +101,8 @@ class Hybrid(Strategy):
         return True
 
     def end_run(self) -> None:
+        if self._engine:
+            self._engine.end_run()  # the coarse twin hands over unless the run goes on
         self._leave_rigid_phase()
 
     def _leave_rigid_phase(self) -> None:

@@ -1,0 +1,139 @@
+"""The rigid-body strategy's coarse start (foldcore.coarse): a run from rest steps
+the one-strip twin first, then the mesh's own engine from the twin's state."""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import foldcore.strategies.rigid as rigid_strategy
+from foldcore import patterns, thicken
+from foldcore.coarse import Twin, twin_mesh
+from foldcore.simulation import Simulation
+
+TOL = 1e-8
+
+
+def miura(n=4, a=20.0):
+    """Thin Miura n × n (H = 1e-3 a, W = 3H, 4 sub-strips per crease), one zig-zag
+    crease driven to its angle at tilt 30°: (pattern, mesh, closed form, creases)."""
+    h = 1e-3 * a
+    pattern = patterns.miura_one_crease(n, n, a=a, b=a, width=3 * h)
+    creases = np.flatnonzero(patterns.miura_edge_kinds(n, n) != "boundary")
+    expected = patterns.miura_fold_angles(n, n, 60.0, 30.0)[creases]
+    return pattern, thicken(pattern, h), expected, creases
+
+
+def phase(sim) -> str:
+    """"coarse" while the twin steps, else the strategy's phase."""
+    rigid = sim.strategy.rigid if sim.solver == "hybrid" else sim.strategy
+    return "coarse" if rigid is not None and rigid.twin is not None else sim.strategy.phase
+
+
+def fold(pattern, mesh, coarse: bool, monkeypatch, **run):
+    monkeypatch.setattr(rigid_strategy, "COARSE_START", coarse)
+    phases = []
+    sim = Simulation(mesh, pattern)
+    result = sim.run(tolerance=TOL, callback=lambda s, moved: phases.append(phase(s)), **run)
+    return sim, result, phases
+
+
+def test_the_twin_has_one_strip_per_crease_and_the_same_panels():
+    pattern, mesh, _, _ = miura()
+    twin = twin_mesh(mesh, pattern)
+    creases = mesh.subdivisions > 0
+    assert (mesh.subdivisions[creases] == 4).all() and (twin.subdivisions[creases] == 1).all()
+    assert np.array_equal(twin.hinge_width[creases], mesh.hinge_width[creases])
+
+    def centroids(m):
+        g, rest = m.groups["rigid_panel"], m.rest_positions
+        return np.array([rest[g.indices[g.slots(p)]].mean(axis=0) for p in m.panel_of_face])
+
+    assert np.allclose(centroids(twin), centroids(mesh), rtol=0, atol=1e-12 * 80.0)
+    assert twin_mesh(twin, pattern) is None  # already one strip wide: no twin of its own
+
+
+def test_a_fold_from_rest_steps_the_twin_then_confirms_on_the_mesh(monkeypatch):
+    pattern, mesh, expected, creases = miura()
+    sim, result, phases = fold(pattern, mesh, True, monkeypatch)
+    assert result.converged
+    assert phases[0] == "coarse" and phases[-1] == "rigid"
+    assert phases.count("rigid") <= 2  # the twin's equilibrium is the mesh's (axis hinge)
+    # both models meet the closed form; 1e-6° is far above the tolerance's 1e-8 × size
+    assert np.abs(result.fold_angles_deg[creases] - expected).max() < 1e-6
+    # the positions are the mesh engine's, hinge interiors included (not the rest state)
+    assert np.array_equal(sim.x, sim.strategy._engine.engine.x)
+    assert np.abs(sim.x - mesh.rest_positions).max() > 1.0
+
+
+def test_the_coarse_start_lands_where_the_mesh_alone_lands(monkeypatch):
+    pattern, mesh, _, _ = miura()
+    alone, a, phases = fold(pattern, mesh, False, monkeypatch)
+    assert "coarse" not in phases
+    coarse, b, _ = fold(pattern, mesh, True, monkeypatch)
+    size = float(np.ptp(pattern.vertices, axis=0).max())
+    # two runs settled within TOL × size of one equilibrium: a few times that apart
+    assert np.abs(a.positions - b.positions).max() < 100 * TOL * size
+    assert np.nanmax(np.abs(a.fold_angles_deg - b.fold_angles_deg)) < 1e-5
+
+
+def test_handing_over_places_the_hinge_interiors_on_their_strips(monkeypatch):
+    """After the twin's fold the mesh's strips are unstrained: the placed interiors
+    (chained strip by strip from a panel) close on the far panel."""
+    monkeypatch.setattr(rigid_strategy, "COARSE_START", False)
+    pattern, mesh, _, _ = miura(3)
+    fine = Simulation(mesh, pattern, solver="rigid")
+    twin = Twin(fine, twin_mesh(mesh, pattern))
+    twin.mirror(fine)
+    assert twin.sim.run(tolerance=1e-10).converged
+    engine = fine.strategy.engine
+    twin.hand_over(engine)
+    engine._update_shapes(engine.phi)
+    from foldcore import rigid_normal
+
+    rigid_normal.fit_strip_rotations(engine.ids, engine.x, engine.shape.reshape(-1, 8, 3),
+                                     engine.rot_e)
+    residual = engine._residual(engine.x, engine.rot_e)
+    size = float(np.ptp(pattern.vertices, axis=0).max())
+    # every strip row within 1e-10 × size (the twin's tolerance) of its target
+    assert np.abs(residual / engine.sqrt_w[:, None, None]).max() < 1e-10 * size
+
+
+def test_an_interrupted_coarse_phase_ends_at_the_twins_state(monkeypatch):
+    pattern, mesh, _, _ = miura()
+    monkeypatch.setattr(rigid_strategy, "COARSE_START", True)
+    sim = Simulation(mesh, pattern)
+    result = sim.run(tolerance=TOL, callback=lambda s, moved: s.iterations < 12)
+    assert result.reason == "callback" and result.iterations == 12
+    assert sim.strategy.rigid is None or sim.strategy.rigid.twin is None  # handed over
+    assert np.abs(sim.x - mesh.rest_positions).max() > 1e-3  # moved off the rest state
+
+
+def test_no_coarse_start_with_position_targets_or_from_a_folded_state(monkeypatch):
+    pattern, mesh, _, _ = miura(3)
+    monkeypatch.setattr(rigid_strategy, "COARSE_START", True)
+    sim = Simulation(mesh, pattern)
+    sim.add_position_target([0])
+    phases = []
+    sim.run(tolerance=1e-6, callback=lambda s, m: phases.append(phase(s)))
+    assert "coarse" not in phases
+    sim = Simulation(mesh, pattern)
+    assert sim.run(tolerance=1e-6).converged
+    sim.set_fold_percent(80.0)
+    phases = []
+    sim.run(tolerance=1e-6, callback=lambda s, m: phases.append(phase(s)))
+    assert phases and "coarse" not in phases
+
+
+@pytest.mark.parametrize("solver", ["rigid", "hybrid"])
+def test_a_binding_vertex_settles_from_the_twin_as_from_rest(solver, monkeypatch):
+    """W/H = 0.3: the hinge model binds 2.7° short of the closed form; with k sub-strips
+    its equilibrium is not the twin's, and the mesh's own steps finish the run."""
+    pattern = patterns.degree4_vertex(radius=10.0, widths=[0.3 * 0.01] * 4, mode="A", rho1=70.0)
+    mesh = thicken(pattern, 0.01)
+    results = []
+    for coarse in (False, True):
+        monkeypatch.setattr(rigid_strategy, "COARSE_START", coarse)
+        sim = Simulation(mesh, pattern, solver=solver)
+        results.append(sim.run(tolerance=TOL, max_iterations=500))
+    assert all(r.converged for r in results)
+    assert np.nanmax(np.abs(results[0].fold_angles_deg - results[1].fold_angles_deg)) < 1e-4
