@@ -110,7 +110,7 @@ class Rigid(Strategy):
             return
         t0 = time.perf_counter()
         self.twin.hand_over(self.engine)
-        self.twin = None
+        self.twin = self._twin = None  # freed before the mesh's own step allocates (peak memory)
         self.sim.x = self.engine.x
         if self.sim._hinges is not None:
             self.sim._hinges.state[:, 0] = self.engine.phi
