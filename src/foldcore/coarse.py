@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from elements.bending_hinge import FLOOR, TARGET
+from elements.bending_hinge import FLOOR
 
 
 def twin_mesh(mesh, pattern):
@@ -52,8 +52,7 @@ def twin_mesh(mesh, pattern):
     hinge_factor[strips.source] = strips.weights / strips.volumes
     panel_factor = np.ones(len(pattern.faces))
     panel_factor[panels.source] = panels.weights / panels.volumes
-    models = np.where(mesh.hinge_model == "", None, mesh.hinge_model) \
-        if mesh.hinge_model is not None else None
+    models = np.where(mesh.hinge_model == "", None, mesh.hinge_model)  # "" on boundaries
     return thicken(pattern, mesh.thickness, hinge_width=mesh.hinge_width,
                    subdivisions=np.where(creases, 1, 0), hinge=models,
                    stiffness={"hinge": hinge_factor, "panel": panel_factor})
@@ -86,15 +85,15 @@ class Twin:
         self._k = mesh.subdivisions[self._edge].astype(float)
 
     def mirror(self, sim) -> None:
-        """The twin's strip targets and floors from ``sim``'s, crease by crease (a
-        strip carries its crease's value over its k sub-strips)."""
-        fine, twin = sim._hinges.params, self.sim._hinges.params
-        for column in (TARGET, FLOOR):
-            per_edge = np.full(sim.pattern.n_edges, np.nan)
-            per_edge[self._edge_of_fine] = fine[:, column] * self._k_fine
-            self.sim._hinges.set_params(slice(None), column, per_edge[self._edge] / self._k)
-        self.sim._passive = np.isnan(twin[:, TARGET])
-        self.sim._sync_hinge_weights()
+        """The twin's targets (``sim``'s fold targets and fold percent, through its own
+        :meth:`Simulation._apply_fold_targets`) and floors (crease by crease: a strip
+        carries its crease's floor over its k sub-strips) from ``sim``'s."""
+        twin = self.sim
+        twin._fold_targets, twin._percent = sim._fold_targets.copy(), sim._percent
+        twin._apply_fold_targets()  # strip targets, passive flags, weights
+        floor = np.full(sim.pattern.n_edges, np.nan)
+        floor[self._edge_of_fine] = sim._hinges.params[:, FLOOR] * self._k_fine
+        twin._hinges.set_params(slice(None), FLOOR, floor[self._edge] / self._k)
 
     def hand_over(self, engine) -> None:
         """Put ``engine`` (the fine mesh's :class:`~foldcore.rigid_body.RigidBodySolver`)

@@ -155,6 +155,7 @@ class RigidBodySolver:
         self.contraction = np.nan  # its length over the last accepted one's, this run
         self._accepted_move = None  # mm, the run's last accepted step, if the last step
         self._last_lin = None  # the last step's linear model (distance_left)
+        self._chains = None  # place_interiors' batches, built on first use
         self.distance = np.inf  # mm, estimated distance left after the last step
         self.energy_scale = 0.0
         self._passive = None
@@ -902,7 +903,7 @@ class RigidBodySolver:
     def _interior_chains(self) -> list:
         """[(strips (b,), known local vertices (b, 4), unknown ones (b, 4))] per place
         in the creases' series of strips, for :meth:`place_interiors`; built once."""
-        if getattr(self, "_chains", None) is not None:
+        if self._chains is not None:
             return self._chains
         known = self.owner >= 0
         chains = [np.asarray(c) for c in self.sim.mesh.strips_of_crease.values()]

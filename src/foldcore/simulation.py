@@ -544,18 +544,18 @@ class Simulation:
         self.equilibrium.begin_run()
         with blas_on_one_thread(self._guard_blas):
             try:
-                if self._starts_flat():
+                branch_stage = self._starts_flat()
+                if branch_stage:
                     self.stage = "branch"
                     used, branch = self._branch_stage(budget, callback, limit)
                     budget -= used
                     if branch == "callback":
                         reason = branch
-                    self.stage = "run"
-                    if budget <= 0 or reason == "callback":
-                        self.strategy.end_run()  # no stage follows the branch stage
                 self.stage = "run"
                 if budget > 0 and reason != "callback":
                     _, reason = self._stage(budget, callback, limit)
+                elif branch_stage:
+                    self.strategy.end_run()  # the run ends with its branch stage
             finally:
                 self.stage = None
         self.timings["total"] += time.perf_counter() - start

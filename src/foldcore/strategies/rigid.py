@@ -67,21 +67,24 @@ class Rigid(Strategy):
         t0, solve0 = time.perf_counter(), engine.solve_time
         out = call(*args)
         if engine is self.engine:
-            sim.x = engine.x
-            if sim._hinges is not None:
-                sim._hinges.state[:, 0] = engine.phi
+            self._sync_sim()
         solve = engine.solve_time - solve0
         sim.timings["solve"] += solve
         sim.timings["projection"] += time.perf_counter() - t0 - solve
         return out
+
+    def _sync_sim(self) -> None:
+        """Hand the mesh's engine's positions and strip angles to the simulation."""
+        self.sim.x = self.engine.x
+        if self.sim._hinges is not None:
+            self.sim._hinges.state[:, 0] = self.engine.phi
 
     def begin_run(self) -> None:
         if self._run != self.sim.runs:  # a new Simulation.run, not its second stage
             self._run = self.sim.runs
             self.engine.new_run()
             if self._at_rest() and self._coarse_twin() is not None:
-                self.twin = self._twin
-                self.twin.engine.resync(self.twin.sim.mesh.rest_positions)
+                self.twin = self._twin  # fresh: each is dropped at its hand-over
                 self.twin.engine.new_run()
         if self.twin is not None:
             self.twin.mirror(self.sim)  # this stage's targets and floors
@@ -111,9 +114,7 @@ class Rigid(Strategy):
         t0 = time.perf_counter()
         self.twin.hand_over(self.engine)
         self.twin = self._twin = None  # freed before the mesh's own step allocates (peak memory)
-        self.sim.x = self.engine.x
-        if self.sim._hinges is not None:
-            self.sim._hinges.state[:, 0] = self.engine.phi
+        self._sync_sim()
         self.sim.timings["projection"] += time.perf_counter() - t0
 
     def end_run(self) -> None:
