@@ -249,15 +249,15 @@ def test_read_result_finds_explicit_subdivisions(tmp_path):
 
 
 def test_a_result_with_elastic_panels_reads_back_and_exports(tmp_path, capsys):
-    """foldcore:faces_cells carries the cell counts, so the bar and plate cells are
-    rebuilt (same mesh, same positions) and the folded solid exports watertight; a
+    """foldcore:faces_cells carries the cell counts, so the bar, plate and ring cells
+    are rebuilt (same mesh, same positions) and the folded solid exports watertight; a
     malformed entry is refused naming the face, exit code 2 from the CLI."""
     from foldcore.outputs import write_result
     from foldcore.simulation import Simulation
     from foldcore.thickening import thicken
 
     pattern = patterns.single_hinge(panel_length=20.0, depth=20.0, angle=60.0, width=2.0)
-    for elastic in ({1: 3}, {0: (3, 2), 1: (4, 3)}):
+    for elastic in ({1: 3}, {0: (3, 2), 1: (4, 3)}, {0: ("rings", 2), 1: ("rings", 3)}):
         mesh = thicken(pattern, 1.0, subdivisions=2, elastic=elastic)
         result = Simulation(mesh, pattern).run(tolerance=1e-9, max_iterations=2_000)
         path = tmp_path / "plate.fold"

@@ -161,3 +161,25 @@ def test_the_report_gives_the_effective_targets_at_the_fold_percent(hinge_file, 
     rep = json.loads(report.read_text())
     assert rep["target_angles_deg"][0] == pytest.approx(27.0)  # 30 % of 90°
     assert rep["actuation"]["creases"][0]["target_deg"] == pytest.approx(27.0)
+
+
+def test_elastic_cells_cut_every_face_into_rings_and_fold_a_compatible_target(tmp_path):
+    """--elastic-cells MM: every face in rings of ~MM mm cells (rebuilt from the result
+    file), recorded in the report. The FOLD project's diagonal fold (one crease, two
+    triangles) is compatible, so elastic panels meet its target as rigid ones do —
+    to the tolerance's angle, 1e-8 × size / cell size ≈ 1e-4° at most."""
+    from foldcore.fabrication import read_result
+
+    report = tmp_path / "diag.json"
+    done = foldcore.job.fold(REAL + "diagonal-cp.fold", thickness=0.5, sheet_size=100.0,
+                             fold_percent=90, elastic_cells=10.0, max_iterations=20_000,
+                             output=tmp_path / "diag.fold", report=report)
+    faces = done.pattern.faces
+    assert set(done.mesh.elastic) == set(range(len(faces)))
+    assert all(kind == "rings" and n >= 2 for kind, n in done.mesh.elastic.values())
+    assert done.result.converged
+    crease = done.pattern.creases
+    assert np.abs(done.result.fold_angles_deg[crease]).max() == pytest.approx(162.0, abs=1e-4)
+    assert json.loads(report.read_text())["settings"]["elastic_cells_mm"] == 10.0
+    back = read_result(tmp_path / "diag.fold")
+    assert back.mesh.elastic == done.mesh.elastic

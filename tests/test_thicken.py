@@ -881,9 +881,11 @@ def test_elastic_panels_are_cells_along_the_bar():
         thicken(pattern, 2.0, elastic={1: "auto"})
     with pytest.raises(MeshError, match="face 7 does not exist"):
         thicken(pattern, 2.0, elastic={7: 3})
-    vertex = patterns.degree4_vertex(radius=20.0, widths=[1.0] * 4)
+    grid = patterns.grid(2, 2, size=20.0, assignment="V")  # quads with two crease sides
     with pytest.raises(MeshError, match="only quadrilateral faces with exactly one crease"):
-        thicken(vertex, 1.0, elastic={0: 3})
+        thicken(grid, 1.0, elastic={0: 3})
+    vertex = patterns.degree4_vertex(radius=20.0, widths=[1.0] * 4)  # not quads: rings
+    assert thicken(vertex, 1.0, elastic={0: 3}).elastic == {0: ("rings", 3)}
 
 
 # ============================================================ 2D elastic plates
@@ -1001,3 +1003,91 @@ def test_every_quad_face_a_plate_on_a_grid_and_on_a_miura():
     assert len(cells) > 9 * 16 and {len(p.top) for p in cells} <= {3, 4}
     with pytest.raises(MeshError, match="elastic must be a dict"):
         thicken(grid, 1.0, elastic="cells")
+
+
+# ============================================================ elastic facets (rings)
+def test_facets_are_rings_that_tile_every_face_and_conform():
+    """elastic="facets": every face (here the waterbomb's triangles) cut into rings —
+    scaled copies of its outline toward its centroid — quads between rings and a
+    fan of triangles at the centre. The outline is the panel's own, so the cells
+    tile it (same volume as the rigid mesh), share whole edges with the strips
+    (no T-junctions), run counter-clockwise; the ring count is ⌈reach / cell_size⌉
+    (reach: farthest outline point from the centroid)."""
+    pattern = patterns.waterbomb(radius=30.0)
+    plain = thicken(pattern, 1.0, subdivisions=2)
+    mesh = thicken(pattern, 1.0, subdivisions=2, elastic="facets", cell_size=6.0)
+    assert mesh.volume() == pytest.approx(plain.volume())
+    assert not hanging_points(mesh)
+    assert all(shoelace(mesh.points[p.top]) > 0 for p in prisms_of(mesh))
+    panels = mesh.groups["rigid_panel"]
+    for f in range(len(pattern.faces)):
+        outline = plain.points[_top(plain, int(plain.panel_of_face[f]))]
+        centre = shapely.Polygon(outline).centroid
+        reach = max(np.hypot(*(p - np.array(centre.coords[0]))) for p in outline)
+        rings = math.ceil(reach / 6.0)
+        assert mesh.elastic[f] == ("rings", rings)
+        # m outline points: m quads per ring between rings, m triangles at the centre
+        assert (panels.source == f).sum() == len(outline) * rings
+    with pytest.raises(MeshError, match="face 0: the number of rings must be"):
+        thicken(pattern, 1.0, elastic={0: ("rings", 0)})
+    with pytest.raises(MeshError, match="'auto' needs a positive cell_size"):
+        thicken(pattern, 1.0, elastic="facets")
+
+
+def _top(mesh, panel: int) -> np.ndarray:
+    """Footprint point ids of a panel element's top loop."""
+    group = mesh.groups["rigid_panel"]
+    ids = group.indices[group.slots(panel)]
+    return ids[: len(ids) // 2]
+
+
+def test_facet_not_star_shaped_from_its_centroid_is_refused():
+    """A C-shaped face (a 30 mm square with a 20 × 10 notch, filled by a square face)
+    has its centroid (13.6, 15) in the notch, outside the face: refused, naming it."""
+    v = [(0, 0), (30, 0), (30, 10), (10, 10), (10, 20), (30, 20), (30, 30), (0, 30)]
+    e = [(0, 1), (1, 2), (2, 3), (3, 4), (4, 5), (5, 6), (6, 7), (7, 0), (2, 5)]
+    pattern = CreasePattern(v, e, ["B", "B", "V", "V", "V", "B", "B", "B", "B"], source="c")
+    (c_face,) = [f for f, face in enumerate(pattern.faces) if len(face) == 8]
+    with pytest.raises(MeshError, match=f"face {c_face}: its outline is not star-shaped"):
+        thicken(pattern, 1.0, hinge_width=1.0, elastic={c_face: ("rings", 2)})
+
+
+def test_each_crease_is_measured_by_the_cells_beside_it():
+    """On an elastic face each crease's fold angle comes from the face's cell nearest
+    the crease's middle (a bent face is not counted as fold); the cell touches that
+    crease's strip. Rigid faces measure with their one panel."""
+    pattern = patterns.waterbomb(radius=30.0)
+    mesh = thicken(pattern, 1.0, subdivisions=2, elastic="facets", cell_size=6.0)
+    strips = mesh.groups["bending_hinge"]
+    panels = mesh.groups["rigid_panel"]
+    for e in pattern.creases:
+        strip_ids = set(np.concatenate([strips.indices[strips.slots(int(s))]
+                                        for s in mesh.strips_of_crease[int(e)]]))
+        for side, f in enumerate(pattern.edge_faces[e]):
+            cell = int(mesh.crease_panels[e, side])
+            assert panels.source[cell] == f
+            assert strip_ids & set(panels.indices[panels.slots(cell)])
+    rigid = thicken(pattern, 1.0, subdivisions=2)
+    left, right = rigid.measuring_panels(pattern, pattern.creases)
+    np.testing.assert_array_equal(left, rigid.panel_of_face[pattern.edge_faces[pattern.creases, 0]])
+    np.testing.assert_array_equal(right, rigid.panel_of_face[pattern.edge_faces[pattern.creases, 1]])
+
+
+def test_facet_folded_by_a_compatible_hinge_stays_unstrained():
+    """A hinge driven to 90° with its two faces in rings: the target is compatible,
+    so the cells keep their rest shapes (to 1e-6 of the panel length) and the
+    crease reaches 90° measured by the cells beside it."""
+    from foldcore.simulation import Simulation
+
+    pattern = patterns.single_hinge(panel_length=20.0, depth=20.0, width=3.0, angle=90.0)
+    mesh = thicken(pattern, 1.0, subdivisions=2, elastic={0: ("rings", 2), 1: ("rings", 3)})
+    result = Simulation(mesh, pattern).run(tolerance=1e-12, max_iterations=20_000)
+    assert result.converged
+    assert result.fold_angles_deg[0] == pytest.approx(90.0, abs=1e-4)
+    cells, x = mesh.groups["rigid_panel"], result.positions
+    for i in range(len(cells)):
+        ids = cells.indices[cells.slots(i)]
+        d_now = np.linalg.norm(x[ids][:, None] - x[ids][None], axis=2)
+        rest = cells.rest[cells.slots(i)]
+        d_rest = np.linalg.norm(rest[:, None] - rest[None], axis=2)
+        assert np.abs(d_now - d_rest).max() <= 1e-6 * 20.0

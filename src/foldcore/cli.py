@@ -142,6 +142,10 @@ def build_parser() -> argparse.ArgumentParser:
                           "else Eq. 7 with r = 0)")
     sim.add_argument("--subdivisions", type=_subdivisions, default="auto",
                      help="sub-strips per hinge, or 'auto' (default)")
+    sim.add_argument("--elastic-cells", type=_positive, metavar="MM",
+                     help="elastic panels: cut every face into rings of cells about MM mm "
+                          "long, so panels bend and stretch where the targets ask for it "
+                          "(non-rigidly-foldable patterns); runs L-BFGS; default: rigid panels")
     sim.add_argument("--fold-percent", type=float, default=100.0,
                      help="scale all target angles, -100…100 (default 100)")
     sim.add_argument("--solver", default=DEFAULT_SOLVER, choices=SOLVERS,

@@ -84,7 +84,7 @@ def simulate(path, *, thickness: float | None = None, hinge_width: float | None 
              actuation: str = DEFAULT_ACTUATION, branch_floor: float = BRANCH_FLOOR_DEG,
              hinges=None, mv_passive: bool = False, trust_assignment: bool = False,
              scale: float | None = None, sheet_size: float | None = None,
-             output=None, report=None, render=None, animate=None, series=None,
+             elastic_cells: float | None = None, output=None, report=None, render=None, animate=None, series=None,
              frames: int = 20, fps: float = 10.0, callback=None):
     """Fold the pattern file at ``path`` and write the outputs asked for; the Result.
 
@@ -104,6 +104,11 @@ def simulate(path, *, thickness: float | None = None, hinge_width: float | None 
         As :class:`foldcore.Simulation` and its ``run`` (``branch_floor``: degrees).
     mv_passive, trust_assignment, scale, sheet_size
         How the file is read (:class:`foldcore.io.Reading`; ``sheet_size``: mm).
+    elastic_cells : float, optional
+        Elastic panels: every face cut into rings of cells about this long, mm
+        (``thicken(elastic="facets", cell_size=...)``), so panels bend and
+        stretch where the targets ask for it; default rigid panels. Such a mesh
+        runs L-BFGS alone (``hybrid``'s rigid phase takes rigid panels only).
     output, report, render, animate : path, optional
         Result FOLD, JSON report, PNG render, GIF/MP4 of the sweep from 0 to
         ``fold_percent`` in ``frames`` frames at ``fps`` (the last frame's run is
@@ -160,8 +165,10 @@ def fold(path, **options) -> Fold:
     if o["animate"]:  # (an animation interrupted writes nothing: its frames are a sweep)
         from .animate import check_output
         check_output(o["animate"])          # a missing encoder fails before any work
+    cells = o["elastic_cells"]
     mesh = thicken(loaded.pattern, thickness, o["hinge_width"], o["subdivisions"],
-                   hinge=o["hinge"] or loaded.hinge, stiffness=loaded.stiffness)
+                   hinge=o["hinge"] or loaded.hinge, stiffness=loaded.stiffness,
+                   elastic="facets" if cells else None, cell_size=cells)
     sim = Simulation(mesh, loaded.pattern, solver=o["solver"], actuation=o["actuation"],
                      branch_floor_deg=o["branch_floor"])
     interrupted, sweep = False, None
@@ -185,6 +192,7 @@ def fold(path, **options) -> Fold:
                                                         "max_iterations", "subdivisions")}}
     settings.update(thickness_mm=thickness, hinge=sorted(set(mesh.hinge_model) - {""}),
                     actuation=o["actuation"], branch_floor_deg=o["branch_floor"],
+                    elastic_cells_mm=cells,
                     backend=sim.system.factor.backend)
     outputs = {"-o": o["output"], "--report": o["report"], "--render": o["render"]}
     write_result(result, loaded.pattern, mesh, thickness, settings, fold=o["output"],

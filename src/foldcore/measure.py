@@ -38,16 +38,17 @@ def element_rotations(group, positions: np.ndarray) -> np.ndarray:
 def fold_angles(pattern, mesh, positions: np.ndarray) -> np.ndarray:
     """(E,) fold angle of every edge in degrees, valley positive; NaN for ``B`` edges.
 
-    Uses the panels' best-fit rotations R_L, R_R of the faces left and right of
-    each crease a→b: with normals n = R·ẑ and crease direction d = R·(b − a)
+    Uses the best-fit rotations R_L, R_R of the panels left and right of each
+    crease a→b (:meth:`ThickMesh.measuring_panels`: on an elastic face, its cell
+    nearest the crease): with normals n = R·ẑ and crease direction d = R·(b − a)
     averaged over both panels, ρ = atan2((n_R × n_L)·d, n_L·n_R).
     """
     panels = mesh.groups[mesh.panel_group]
     rot = element_rotations(panels, positions)
     out = np.full(pattern.n_edges, np.nan)
     crease = pattern.creases
-    left = rot[mesh.panel_of_face[pattern.edge_faces[crease, 0]]]
-    right = rot[mesh.panel_of_face[pattern.edge_faces[crease, 1]]]
+    left_panels, right_panels = mesh.measuring_panels(pattern, crease)
+    left, right = rot[left_panels], rot[right_panels]
     d2 = pattern.vertices[pattern.edges[crease, 1]] - pattern.vertices[pattern.edges[crease, 0]]
     d_rest = np.column_stack([d2, np.zeros(len(crease))])
     d = np.einsum("nij,nj->ni", left + right, d_rest)
@@ -101,7 +102,7 @@ def crease_overlaps(pattern, mesh, positions: np.ndarray) -> np.ndarray:
     out = np.full(pattern.n_edges, np.nan)
     for e in pattern.creases:
         e = int(e)
-        pair = [int(mesh.panel_of_face[f]) for f in pattern.edge_faces[e]]
+        pair = [int(p[0]) for p in mesh.measuring_panels(pattern, [e])]
         ids = [panels.indices[panels.slots(p)] for p in pair]
         own = np.zeros(0, dtype=np.int64)
         if strips is not None and e in mesh.strips_of_crease:

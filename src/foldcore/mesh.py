@@ -87,6 +87,11 @@ class ThickMesh:
         Hinge kinematics of each crease's bending strips (``"axis"``,
         ``"arc"``, ``"eq8"``; ``""`` for boundary edges), see
         :func:`foldcore.thicken`.
+    crease_panels : (E, 2) int64, optional
+        The panel elements that measure each crease's fold angle, on its faces
+        ``pattern.edge_faces[e]`` (−1 where there is none): the panel, or on an
+        elastic face the cell nearest the crease's middle, so a bent face does
+        not count as fold. Default: ``panel_of_face`` of both faces.
     """
 
     points: np.ndarray
@@ -100,10 +105,19 @@ class ThickMesh:
     panel_group: str = "rigid_panel"
     elastic: dict = field(default_factory=dict)
     hinge_model: np.ndarray | None = None
+    crease_panels: np.ndarray | None = None
 
     def __post_init__(self):
         if self.segments is None:
             self.segments = (np.asarray(self.subdivisions) > 0).astype(np.int64)
+
+    def measuring_panels(self, pattern, edges) -> tuple[np.ndarray, np.ndarray]:
+        """Panel elements (n,), (n,) left and right of the creases ``edges`` (n,) that
+        measure their fold angles (:attr:`crease_panels`)."""
+        if self.crease_panels is not None:
+            return self.crease_panels[edges, 0], self.crease_panels[edges, 1]
+        faces = pattern.edge_faces[edges]
+        return self.panel_of_face[faces[:, 0]], self.panel_of_face[faces[:, 1]]
 
     def crease_bends(self, strip_angles: np.ndarray) -> np.ndarray:
         """(E,) bend of each crease's hinge from per-strip bend angles (S,): the sum over

@@ -330,7 +330,7 @@ def thicken(pattern: CreasePattern, thickness: float, hinge_width=None,
     ks[list(stretch)] = 1
     table = _PointTable()
     corners, corner_ids = _corner_ids(pattern, widths, table)
-    bars, plates = _split_elastic(pattern, elastic)
+    bars, plates, facets = _split_elastic(pattern, elastic)
     plates = _plate_counts(pattern, plates, corners, cell_size)
     segments = _segments(pattern, plates, stretch, bars)
     inserts: list[dict] = [dict() for _ in pattern.faces]
@@ -347,6 +347,8 @@ def thicken(pattern: CreasePattern, thickness: float, hinge_width=None,
     pieces = {frozenset(pair) for lines in strip_points.values() for side in (lines[0], lines[-1])
               for pair in zip(side, side[1:])}
     cells.update(_plate_cells(pattern, loops, corner_ids, plates, table, pieces))
+    facet_cells, rings = _facet_cells(pattern, loops, facets, table, cell_size)
+    cells.update(facet_cells)
     points = np.array(table.coords)
     stiff = stiffness or {}
     panels, panel_of_face = _panel_group(pattern, points, loops, cells, thickness,
@@ -358,11 +360,13 @@ def thicken(pattern: CreasePattern, thickness: float, hinge_width=None,
     if stretch:
         groups["stretch_hinge"] = _stretch_group(pattern, points, strip_points, stretch,
                                                  widths, thickness, stiff.get("hinge", 1.0))
-    built = {**{f: len(c) for f, c in cells.items() if f not in plates}, **plates}
+    built = {**{f: len(c) for f, c in cells.items() if f in bars}, **plates, **rings}
+    measuring = _crease_panels(pattern, points, cells, panels, panel_of_face)
     return ThickMesh(points=points, thickness=float(thickness), groups=groups,
                      panel_of_face=panel_of_face,
                      strips_of_crease=strips_of, hinge_width=widths, subdivisions=ks,
-                     segments=segments, elastic=built, hinge_model=hinges)
+                     segments=segments, elastic=built, hinge_model=hinges,
+                     crease_panels=measuring)
 
 
 def _prism(ids2d, points, thickness):
@@ -411,28 +415,87 @@ def _elastic_cells(pattern, loops, elastic, table, cell_size) -> dict:
     return cells
 
 
-def _split_elastic(pattern, elastic) -> tuple[dict, dict]:
-    """Elastic faces as ({face: n or "auto"} bars, {face: (n1, n2)} plates);
-    ``"plates"``: every quadrilateral face a plate with "auto" counts."""
+def _facet_cells(pattern, loops, facets, table, cell_size) -> tuple[dict, dict]:
+    """({face: [cell loops]}, {face: rings}): each elastic facet (a face that is not a
+    quadrilateral) cut into n rings, scaled copies of its outline toward its
+    centroid: quads between rings, a fan of triangles at the centre. The outline
+    is the panel's own (strip ends and segment points included), so cells and
+    strips conform; the face must be star-shaped from its centroid. The cell
+    nearest the middle of its first crease side comes first (it measures the face)."""
+    cells, counts = {}, {}
+    for f, n in facets.items():
+        loop = loops[f]
+        xy = np.array([table.coords[i] for i in loop])
+        centre = _area_centroid(xy)
+        where = f"{pattern.source}: elastic facet on face {f}"
+        if np.any(_cross(xy - centre, np.roll(xy, -1, axis=0) - centre) <= 0):
+            raise MeshError(f"{where}: its outline is not star-shaped from its centroid, "
+                            "so it cannot be cut into rings; keep it rigid")
+        reach = float(np.linalg.norm(xy - centre, axis=1).max())
+        n = _cell_count(n, reach, cell_size, where,
+                        f"the number of rings must be a positive integer or 'auto', got {n!r}")
+        rings = [list(loop)] + [[table.add(centre + (1.0 - r / n) * (p - centre)) for p in xy]
+                                for r in range(1, n)]
+        middle = table.add(centre)
+        m = len(loop)
+        quads = [[rings[r][i], rings[r][(i + 1) % m], rings[r + 1][(i + 1) % m], rings[r + 1][i]]
+                 for r in range(n - 1) for i in range(m)]
+        fan = [[rings[-1][i], rings[-1][(i + 1) % m], middle] for i in range(m)]
+        found = quads + fan
+        first = _nearest_cell(pattern, f, found, table)
+        cells[f] = [found[first]] + found[:first] + found[first + 1:]
+        counts[f] = ("rings", n)
+    return cells, counts
+
+
+def _area_centroid(xy) -> np.ndarray:
+    """(2,) area centroid of a simple polygon (n, 2), mm."""
+    cross = _cross(xy, np.roll(xy, -1, axis=0))
+    return (xy + np.roll(xy, -1, axis=0)).T @ cross / (3.0 * cross.sum())
+
+
+def _nearest_cell(pattern, f: int, cells: list, table) -> int:
+    """Index of the cell whose centroid is nearest the middle of face ``f``'s first
+    crease side (its first side if it has none)."""
+    face = pattern.faces[f]
+    sides = [(face[i], face[(i + 1) % len(face)]) for i in range(len(face))]
+    creased = [s for s in sides if pattern.assignments[_edge_of(pattern, *s)] != "B"]
+    u, v = (creased or sides)[0]
+    target = 0.5 * (pattern.vertices[u] + pattern.vertices[v])
+    centres = np.array([np.mean([table.coords[i] for i in c], axis=0) for c in cells])
+    return int(np.argmin(np.linalg.norm(centres - target, axis=1)))
+
+
+def _split_elastic(pattern, elastic) -> tuple[dict, dict, dict]:
+    """Elastic faces as ({face: n or "auto"} bars, {face: (n1, n2)} plates,
+    {face: n or "auto"} facets cut into rings — ``("rings", n)``, or a count on a
+    face that is not a quadrilateral); ``"plates"``: every quadrilateral face a
+    plate with "auto" counts; ``"facets"``: every face rings with "auto" counts."""
     if isinstance(elastic, str):
-        if elastic != "plates":
-            raise MeshError(f"{pattern.source}: elastic must be a dict {{face: cells}} or "
-                            f"'plates', got {elastic!r}")
-        return {}, {f: ("auto", "auto") for f, face in enumerate(pattern.faces)
-                    if len(face) == 4}
-    bars, plates = {}, {}
+        if elastic == "plates":
+            return {}, {f: ("auto", "auto") for f, face in enumerate(pattern.faces)
+                        if len(face) == 4}, {}
+        if elastic == "facets":
+            return {}, {}, {f: "auto" for f in range(len(pattern.faces))}
+        raise MeshError(f"{pattern.source}: elastic must be a dict {{face: cells}}, "
+                        f"'plates' or 'facets', got {elastic!r}")
+    bars, plates, facets = {}, {}, {}
     for f, n in dict(elastic or {}).items():
         f = int(f)
         if not 0 <= f < len(pattern.faces):
             raise MeshError(f"{pattern.source}: elastic panel: face {f} does not exist")
-        if isinstance(n, (tuple, list)):
+        if isinstance(n, (tuple, list)) and len(n) == 2 and n[0] == "rings":
+            facets[f] = n[1]
+        elif isinstance(n, (tuple, list)):
             if len(n) != 2:
                 raise MeshError(f"{pattern.source}: elastic plate on face {f}: give two cell "
-                                f"counts (n1, n2), got {n!r}")
+                                f"counts (n1, n2) or ('rings', n), got {n!r}")
             plates[f] = tuple(n)
+        elif len(pattern.faces[f]) != 4:
+            facets[f] = n
         else:
             bars[f] = n
-    return bars, plates
+    return bars, plates, facets
 
 
 def _plate_counts(pattern, plates, corners, cell_size) -> dict:
@@ -681,6 +744,23 @@ def _panel_group(pattern, points, loops, cells, thickness, stiffness):
     factor = np.broadcast_to(np.asarray(stiffness, dtype=float), (len(loops),))[source]
     return (_group("rigid_panel", prisms, rests, np.zeros((len(prisms), 0)), vols,
                    vols * factor, source), np.array(panel_of_face, dtype=np.int64))
+
+
+def _crease_panels(pattern, points, cells, panels, panel_of_face) -> np.ndarray:
+    """(E, 2) the panel elements measuring each crease on its two faces (−1: none):
+    the face's panel, or the cell of an elastic face whose footprint centroid is
+    nearest the crease's middle (cells of face f are numbered from
+    ``panel_of_face[f]`` on, in the order of ``cells[f]``)."""
+    faces = pattern.edge_faces
+    out = np.where(faces >= 0, panel_of_face[np.maximum(faces, 0)], -1)
+    for e in pattern.creases:
+        middle = pattern.vertices[pattern.edges[e]].mean(axis=0)
+        for side, f in enumerate(faces[e]):
+            if f >= 0 and int(f) in cells:
+                centres = np.array([points[c].mean(axis=0) for c in cells[int(f)]])
+                nearest = int(np.argmin(np.linalg.norm(centres - middle, axis=1)))
+                out[e, side] = panel_of_face[f] + nearest
+    return out
 
 
 def _polygon_area(xy) -> float:

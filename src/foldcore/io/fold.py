@@ -29,8 +29,9 @@ foldcore's own keys (lengths in the file's ``frame_unit``; foldcore writes mm):
   valley positive, ``null`` = passive. When present it is read instead of
   ``edges_foldAngle``, so a result file reads back as the pattern simulated.
 * ``foldcore:faces_cells`` — in a result of a mesh with elastic panels: per
-  face ``null`` (rigid), a cell count (a bar) or two (a plate), as given to
-  ``thicken(elastic=...)``, so the mesh can be rebuilt.
+  face ``null`` (rigid), a cell count (a bar), two (a plate) or
+  ``["rings", n]`` (a facet in n rings), as given to ``thicken(elastic=...)``,
+  so the mesh can be rebuilt.
 * ``foldcore:edges_poisson`` — in a result of a mesh with stretch hinges: per
   edge ``null`` (a bending hinge or boundary) or the stretch hinge's Poisson
   ratio ν, as given to ``thicken(stretch=...)``.
@@ -513,7 +514,8 @@ def _plain_numbers(raw) -> bool:
 
 
 def faces_cells(d: dict, n_faces: int, source: str) -> dict:
-    """``{face: n or (n1, n2)}`` from ``foldcore:faces_cells`` ({} when absent)."""
+    """``{face: n, (n1, n2) or ("rings", n)}`` from ``foldcore:faces_cells`` ({} when
+    absent)."""
     raw = d.get(CELLS_KEY)
     if raw is None:
         return {}
@@ -523,10 +525,12 @@ def faces_cells(d: dict, n_faces: int, source: str) -> dict:
         if x is None:
             continue
         counts = list(x) if isinstance(x, ARRAY) else [x]
+        rings = len(counts) == 2 and counts[0] == "rings"
         if len(counts) not in (1, 2) or not all(
-                isinstance(c, int) and not isinstance(c, bool) and c >= 1 for c in counts):
-            _fail(source, f"{CELLS_KEY}[{f}] (face {f}) must be null, a cell count ≥ 1 or "
-                          f"two of them, got {_short(x)}")
+                isinstance(c, int) and not isinstance(c, bool) and c >= 1
+                for c in counts[rings:]):
+            _fail(source, f"{CELLS_KEY}[{f}] (face {f}) must be null, a cell count ≥ 1, "
+                          f"two of them or [\"rings\", count], got {_short(x)}")
         out[f] = tuple(counts) if len(counts) == 2 else counts[0]
     return out
 
