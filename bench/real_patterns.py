@@ -13,6 +13,11 @@ benchmark; times are single runs on a shared machine, load recorded).
 
 Run: ``.venv/bin/python bench/real_patterns.py`` (a few minutes). Writes
 bench/results/real_patterns.json and prints the README table.
+
+``--elastic``: the files whose rigid panels bind, again with elastic panels
+(``elastic_cells`` = CELL mm: every face in rings of cells, the command line's
+``--elastic-cells``), at most ELASTIC_BUDGET iterations (L-BFGS alone: such a
+mesh has no rigid phase); writes bench/results/real_patterns_elastic.json.
 """
 from __future__ import annotations
 
@@ -35,6 +40,13 @@ H = 0.5  # mm, thickness
 BUDGET = 3000
 PERCENTS = (30, 60, 90)
 SKIP = {"BoxPleatPyramid.fold": "2 704 vertices: minutes per fold (issue 17)"}
+CELL = 10.0  # mm, elastic cells (--elastic)
+ELASTIC_BUDGET = 40_000
+#: files folded again with elastic panels: those that bind with rigid ones, without
+#: the two largest (hypar, miura-ori: minutes per elastic fold)
+ELASTIC = ("bird-base-3d.fold", "crane.fold", "resch-tess.fold", "mapfold.svg",
+           "simpleVertex.svg", "singlesquaretwist.svg", "squareBase.svg",
+           "waterbombBase.svg")
 
 
 def wrong_side(pattern, angles) -> int:
@@ -44,7 +56,7 @@ def wrong_side(pattern, angles) -> int:
     return int(np.count_nonzero((kinds == "M") & (a > 1.0) | (kinds == "V") & (a < -1.0)))
 
 
-def run_one(path: Path, percent: float) -> dict:
+def run_one(path: Path, percent: float, elastic_cells=None, budget=BUDGET) -> dict:
     from foldcore.errors import FoldcoreError
     from foldcore.job import fold
     from foldcore.outputs import actuation_entries
@@ -54,7 +66,7 @@ def run_one(path: Path, percent: float) -> dict:
         warnings.simplefilter("always")
         try:
             done = fold(path, thickness=H, sheet_size=SHEET, fold_percent=percent,
-                        max_iterations=BUDGET)
+                        max_iterations=budget, elastic_cells=elastic_cells)
         except FoldcoreError as exc:
             return {"refused": str(exc).replace(str(path), path.name)}
     seconds = time.perf_counter() - start
@@ -67,15 +79,18 @@ def run_one(path: Path, percent: float) -> dict:
             "warnings": sorted({w.category.__name__ for w in caught})}
 
 
-def main() -> None:
+def main(elastic: bool = False) -> None:
     load = os.getloadavg()
     rows, cases = [], []
     for path in sorted(CORPUS.glob("*.fold")) + sorted(CORPUS.glob("*.svg")):
-        if path.name in SKIP:
-            cases.append({"file": path.name, "skipped": SKIP[path.name]})
+        if path.name in SKIP or (elastic and path.name not in ELASTIC):
+            if not elastic:
+                cases.append({"file": path.name, "skipped": SKIP[path.name]})
             continue
         for percent in PERCENTS:
-            case = {"file": path.name, "fold_percent": percent, **run_one(path, percent)}
+            extra = dict(elastic_cells=CELL, budget=ELASTIC_BUDGET) if elastic else {}
+            case = {"file": path.name, "fold_percent": percent,
+                    **run_one(path, percent, **extra)}
             cases.append(case)
             print(json.dumps(case), flush=True)
             if "refused" in case:
@@ -94,13 +109,16 @@ def main() -> None:
                          f"{c['seconds']:.2f}",
                          f"{c['miss_max_deg']:.3g} / {c['miss_median_deg']:.3g}",
                          c["wrong_side"]])
-    out = {"sheet_mm": SHEET, "thickness_mm": H, "budget": BUDGET, "cases": cases,
+    out = {"sheet_mm": SHEET, "thickness_mm": H, "cases": cases,
+           "budget": ELASTIC_BUDGET if elastic else BUDGET,
+           "elastic_cells_mm": CELL if elastic else None,
            "load_before": load, "load_after": os.getloadavg(), "machine": machine_meta()}
-    (ROOT / "bench" / "results" / "real_patterns.json").write_text(json.dumps(out, indent=1))
+    name = "real_patterns_elastic.json" if elastic else "real_patterns.json"
+    (ROOT / "bench" / "results" / name).write_text(json.dumps(out, indent=1))
     rows = [[str(cell) for cell in row] for row in rows]
     print(markdown_table(["file", "fold %", "verdict", "iterations", "s",
                           "miss max / median (°)", "wrong side"], rows))
 
 
 if __name__ == "__main__":
-    main()
+    main(elastic="--elastic" in sys.argv[1:])

@@ -183,3 +183,25 @@ def test_elastic_cells_cut_every_face_into_rings_and_fold_a_compatible_target(tm
     assert json.loads(report.read_text())["settings"]["elastic_cells_mm"] == 10.0
     back = read_result(tmp_path / "diag.fold")
     assert back.mesh.elastic == done.mesh.elastic
+
+
+def test_a_crease_folded_to_the_other_side_is_counted_and_said():
+    """A driven crease that ended on the other side of flat (by more than the miss
+    tolerance) counts in ``wrong_side`` and in the binding warning."""
+    from types import SimpleNamespace
+
+    from foldcore.outputs import MISS_WARNING_DEG, actuation_entries, run_summary
+
+    pattern = patterns.single_hinge(panel_length=5.0, depth=2.0, angle=60.0, width=2.0)
+    edges = np.full(pattern.n_edges, np.nan)
+    crease = int(pattern.creases[0])
+    targets, achieved = edges.copy(), edges.copy()
+    targets[crease] = 60.0
+    for angle, wrong in ((-2.0 * MISS_WARNING_DEG, 1), (-0.5 * MISS_WARNING_DEG, 0), (30.0, 0)):
+        achieved[crease] = angle
+        result = SimpleNamespace(target_angles_deg=targets, fold_angles_deg=achieved,
+                                 converged=True, iterations=1, reason="converged",
+                                 timings_s={"total": 0.1})
+        assert actuation_entries(result, pattern)["wrong_side"] == wrong
+        _, said = run_summary(result, pattern, "hinge.fold", 100)
+        assert len(said) == 1 and ("1 folded to the other side" in said[0]) == bool(wrong)

@@ -111,3 +111,67 @@ class Twin:
         fold_of_edge = np.full(self.sim.pattern.n_edges, np.nan)
         fold_of_edge[twin.fold_edges()] = twin.folds()
         engine.adopt(rot_p, c_p, fold_of_edge, energy_scale=twin.energy_scale, lam=twin.lam)
+
+
+def in_rings(mesh) -> bool:
+    """Whether ``mesh`` has elastic cells, all of them faces cut into rings, and only
+    panels and bending hinges (what :func:`rigid_twin_mesh` serves)."""
+    return (set(mesh.groups) == {"rigid_panel", "bending_hinge"} and bool(mesh.elastic)
+            and all(isinstance(n, tuple) and n[0] == "rings" for n in mesh.elastic.values()))
+
+
+def rigid_twin_mesh(mesh, pattern):
+    """The mesh thickened again with rigid panels (same widths, sub-strips, hinge
+    models and stiffness factors), or None where it cannot serve: a mesh without
+    elastic cells, one with bars or plates (their strips are split or their
+    points come first), or groups other than panels and bending hinges. Every
+    face of an elastic mesh cut into rings keeps its strips whole and adds its
+    ring points after the rigid mesh's, so the twin's points are the mesh's
+    first ones (checked) and :func:`place_cells` maps a twin state onto it."""
+    from .thickening import thicken
+
+    if not in_rings(mesh):
+        return None
+    strips = mesh.groups["bending_hinge"]
+    panels = mesh.groups["rigid_panel"]
+    hinge_factor = np.ones(pattern.n_edges)
+    hinge_factor[strips.source] = strips.weights / strips.volumes
+    panel_factor = np.ones(len(pattern.faces))
+    panel_factor[panels.source] = panels.weights / panels.volumes
+    models = np.where(mesh.hinge_model == "", None, mesh.hinge_model)
+    twin = thicken(pattern, mesh.thickness, hinge_width=mesh.hinge_width,
+                   subdivisions=mesh.subdivisions, hinge=models,
+                   stiffness={"hinge": hinge_factor, "panel": panel_factor})
+    m = len(twin.points)
+    if m > len(mesh.points) or not np.array_equal(twin.points, mesh.points[:m]):
+        return None
+    return twin
+
+
+def place_cells(mesh, twin, twin_x: np.ndarray) -> np.ndarray:
+    """(N, 3) mm: positions of ``mesh`` (elastic, in rings) at a state ``twin_x`` of
+    its :func:`rigid_twin_mesh`: the twin's points as they are, every ring point
+    moved with its face's panel (best-fit rotation and centroid), so the cells
+    start at their rest shapes wherever the panels are rigid."""
+    from .measure import element_rotations
+
+    m_twin, m = len(twin.points), len(mesh.points)
+    twin_panels, cells = twin.groups["rigid_panel"], mesh.groups["rigid_panel"]
+    rotations = element_rotations(twin_panels, twin_x)
+    sizes = np.diff(twin_panels.indptr)
+    starts = twin_panels.indptr[:-1]
+    centres = np.add.reduceat(twin_x[twin_panels.indices], starts, axis=0) / sizes[:, None]
+    rest = twin.rest_positions
+    rest_centres = np.add.reduceat(rest[twin_panels.indices], starts, axis=0) / sizes[:, None]
+    panel_of = np.full(m, -1, dtype=np.int64)  # each 2D point's face panel (in the twin)
+    for c in range(len(cells)):
+        ids = cells.indices[cells.slots(c)]
+        panel_of[ids % m] = twin.panel_of_face[cells.source[c]]
+    x = np.empty((2 * m, 3))
+    x[:m_twin], x[m:m + m_twin] = twin_x[:m_twin], twin_x[m_twin:]
+    new = np.arange(m_twin, m)
+    for layer in (0, m):
+        p = panel_of[new]
+        local = mesh.rest_positions[new + layer] - rest_centres[p]
+        x[new + layer] = np.einsum("nij,nj->ni", rotations[p], local) + centres[p]
+    return x

@@ -84,8 +84,8 @@ def simulate(path, *, thickness: float | None = None, hinge_width: float | None 
              actuation: str = DEFAULT_ACTUATION, branch_floor: float = BRANCH_FLOOR_DEG,
              hinges=None, mv_passive: bool = False, trust_assignment: bool = False,
              scale: float | None = None, sheet_size: float | None = None,
-             elastic_cells: float | None = None, output=None, report=None, render=None, animate=None, series=None,
-             frames: int = 20, fps: float = 10.0, callback=None):
+             elastic_cells: float | None = None, output=None, report=None, render=None,
+             animate=None, series=None, frames: int = 20, fps: float = 10.0, callback=None):
     """Fold the pattern file at ``path`` and write the outputs asked for; the Result.
 
     Parameters

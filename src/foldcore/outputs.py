@@ -98,20 +98,23 @@ def run_summary(result, pattern, source: str, fold_percent: float) -> tuple[str,
                      "as it is; give edges_foldAngle, or M/V creases without angles "
                      "(and no --mv-passive)")
     elif entries["binding"]:
-        missed = entries["missed"]
+        missed, wrong = entries["missed"], entries["wrong_side"]
         warns.append(f"{source}: converged, but {missed} of {driven} driven creases miss "
-                     f"their targets by more than {MISS_WARNING_DEG:g}° (up to {worst:.3g}°): "
+                     f"their targets by more than {MISS_WARNING_DEG:g}° (up to {worst:.3g}°"
+                     + (f"; {wrong} folded to the other side" if wrong else "") + "): "
                      "the model binds there — these targets cannot all be met at once "
-                     "(with rigid panels: a pattern that is not rigidly foldable); the "
-                     "report's actuation lists each crease (README: Files made for "
-                     "Origami Simulator)")
+                     "(with rigid panels: a pattern that is not rigidly foldable; "
+                     "--elastic-cells lets the panels bend); the report's actuation lists "
+                     "each crease (README: Files made for Origami Simulator)")
     return line, warns
 
 
 def actuation_entries(result, pattern) -> dict:
     """Per actuated crease: effective target, achieved angle and miss (degrees); the
-    largest and median miss, how many miss by more than :data:`MISS_WARNING_DEG`, and
-    ``binding``: converged with some missed (the targets unreachable in this model)."""
+    largest and median miss, how many miss by more than :data:`MISS_WARNING_DEG`, how
+    many ended on the other side of flat than their target (``wrong_side``, by more
+    than that), and ``binding``: converged with some missed (the targets unreachable
+    in this model)."""
     from .measure import wrapped_deg
 
     targets = result.target_angles_deg if result.target_angles_deg is not None \
@@ -124,9 +127,11 @@ def actuation_entries(result, pattern) -> dict:
                                      miss)]
     worst = float(np.abs(miss).max()) if len(miss) else 0.0
     missed = int(np.count_nonzero(np.abs(miss) > MISS_WARNING_DEG))
+    wrong = np.sign(targets[driven]) * result.fold_angles_deg[driven] < -MISS_WARNING_DEG
     return {"creases": creases, "largest_miss_deg": worst,
             "median_miss_deg": float(np.median(np.abs(miss))) if len(miss) else 0.0,
             "missed": missed, "miss_tolerance_deg": MISS_WARNING_DEG,
+            "wrong_side": int(np.count_nonzero(wrong)),
             "binding": bool(result.converged and missed > 0)}
 
 

@@ -309,9 +309,18 @@ def thicken(pattern: CreasePattern, thickness: float, hinge_width=None,
         at acute/obtuse corners) the gap adds a column of cells, or a triangle
         where the opposite side has no gap.
         ``panel_of_face`` names the cell at the middle of its first crease
-        side. ``"auto"`` (for n or either of n1, n2): ⌈length / ``cell_size``⌉
-        (a plate: the longer of the two sides). ``elastic="plates"``: every
-        quadrilateral face a plate with "auto" counts (other faces stay rigid).
+        side. ``("rings", n)`` (a facet, any face; a plain count on a face that
+        is not a quadrilateral means the same): n rings, scaled copies of the
+        panel's outline toward its centroid, quads between them and a fan of
+        triangles at the centre; the outline is the panel's own, so the strips
+        stay whole; the face must be star-shaped from its centroid.
+        ``"auto"`` (for n or either of n1, n2): ⌈length / ``cell_size``⌉
+        (a plate: the longer of the two sides; a facet: the farthest outline
+        point from the centroid). ``elastic="plates"``: every quadrilateral
+        face a plate with "auto" counts (other faces stay rigid);
+        ``elastic="facets"``: every face a facet with "auto" rings. Each
+        crease's fold angle is measured by the cells beside it
+        (``ThickMesh.crease_panels``).
     cell_size : float, optional
         Target cell length (mm) for ``"auto"`` counts.
 

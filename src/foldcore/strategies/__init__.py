@@ -13,8 +13,10 @@ one strategy, which only moves the state. Built in:
   acceleration (:mod:`.rigid`, engine in :mod:`foldcore.rigid_body`).
 * ``hybrid`` — a composite: each run starts with ``rigid`` steps, ends
   there once they meet the tolerance, else continues with ``lbfgs`` from
-  where they stop; a mesh ``rigid`` cannot take (elastic cells, other
-  element types) runs ``lbfgs`` (:mod:`.hybrid`).
+  where they stop; a mesh with elastic cells runs ``newton``, one with other
+  element types ``lbfgs`` (:mod:`.hybrid`).
+* ``newton`` — Gauss–Newton / Levenberg–Marquardt on every vertex, each
+  step corrected by the paper's map (:mod:`.newton`): for elastic cells.
 
 The protocol (:class:`Strategy`): ``step()`` advances ``sim.x`` by one
 iteration and returns (energy before, largest move in mm); ``settled(moved,
@@ -32,7 +34,7 @@ from __future__ import annotations
 
 import importlib
 
-SOLVERS = ("paper", "anderson", "lbfgs", "rigid", "hybrid")
+SOLVERS = ("paper", "anderson", "lbfgs", "rigid", "hybrid", "newton")
 _BUILTIN_MODULES = {name: f"foldcore.strategies.{name}" for name in SOLVERS}
 _REGISTRY: dict[str, type] = {}
 

@@ -16,7 +16,10 @@ phase only changes the state within the tolerance on compatible scenes, and
 under angle-controlled actuation its 10³ stiffness contrast kept it from
 converging at all (Pehrson's vertex folded flat: rigid 21 iterations, then
 L-BFGS 10 000 without converging). A mesh the rigid phase cannot take
-(elastic cells, other element types) runs L-BFGS alone, and so does a run
+(elastic cells, other element types) runs one strategy alone — L-BFGS, or
+:mod:`.newton` where every elastic face is cut into rings (L-BFGS crawls
+there: that module's docstring), which from the rest state starts on the
+mesh's rigid-panel twin (:class:`_RigidStart`) — and so does a run
 with a fading position target (``decay`` < 1, counted in iterations: the
 rigid phase would settle on the pull before it fades). Bare :meth:`Simulation.step` calls outside a run are L-BFGS steps;
 whatever ends a rigid phase (its criterion, the budget, an exception or an
@@ -31,30 +34,91 @@ import numpy as np
 from ..errors import SimulationError
 from . import Strategy
 from .lbfgs import Lbfgs
-from .rigid import Rigid
+from .newton import Newton
+from .rigid import REST_TOL, Rigid
 
 HYBRID_RIGID_MAX = 1_000  # rigid-body steps at most per run (Miura 20 × 20, one crease driven: 206)
 HYBRID_RIGID_TOL = 1e-10  # relative step below which the rigid phase ends (even at tolerance 0)
 
 
+def _finishing(sim) -> Strategy:
+    """The strategy after (or instead of) the rigid phase: ``newton`` on a mesh whose
+    elastic faces are all in rings (it starts on their rigid twin: :class:`_RigidStart`),
+    else ``lbfgs``. Why not ``newton`` on bars and plates (no rigid twin there): from
+    rest it turns panels by small linear steps (a plate pair driven to 90°: not
+    converged in 5 000 steps, where L-BFGS takes hundreds)."""
+    from ..coarse import in_rings
+
+    return Newton(sim) if in_rings(sim.mesh) else Lbfgs(sim)
+
+
+class _RigidStart:
+    """The rigid phase of a mesh whose faces are cut into rings: its rigid-panel twin
+    (:func:`foldcore.coarse.rigid_twin_mesh`, a rigid Simulation mirroring the
+    targets and floors, :class:`foldcore.coarse.Twin`) steps from the rest state
+    through the run's stages; its state is then placed on the cells
+    (:func:`foldcore.coarse.place_cells`), where the finishing strategy goes on.
+    Why: a linear step on free vertices turns a panel only by stretching it, so
+    a fold through large angles costs ``newton`` many steps (the FOLD project's
+    diagonal fold to 162°, 10 mm cells: over 3 000 steps, budget; with this
+    start: 12 rigid steps and a few to confirm), and the rigid model is the
+    elastic one's limit of stiff panels."""
+
+    def __init__(self, sim, mesh):
+        from ..coarse import Twin
+
+        self.sim, self.mesh = sim, mesh
+        self.twin = Twin(sim, mesh)
+        self.steps = 0
+
+    def begin(self) -> None:
+        twin = self.twin.sim
+        self.twin.mirror(self.sim)
+        twin.stage = self.sim.stage
+        twin.strategy.begin_run()
+
+    def step(self) -> tuple[float, float]:
+        self.steps += 1
+        moved = self.twin.sim._step()
+        return self.twin.sim.energy_history[-1], moved
+
+    def settled(self, moved: float, limit: float) -> bool:
+        self.twin.sim.stage = self.sim.stage
+        return self.twin.sim.strategy.settled(moved, limit)
+
+    def positions(self) -> np.ndarray:
+        """The mesh's positions at the twin's state, and the twin's run ended."""
+        from ..coarse import place_cells
+
+        twin = self.twin.sim
+        twin.strategy.end_run()
+        twin.stage = None
+        return place_cells(self.sim.mesh, self.mesh, twin.x)
+
+
 class Hybrid(Strategy):
-    """``rigid`` for the first steps of each run, then ``lbfgs``."""
+    """``rigid`` for the first steps of each run, then ``lbfgs`` (``newton`` on rings)."""
 
     name = "hybrid"
 
     def __init__(self, sim):
         super().__init__(sim)
-        self.lbfgs = Lbfgs(sim)
+        self.finish = _finishing(sim)  # L-BFGS, or Newton on elastic cells
         self.rigid = None  # the rigid phase's strategy while it runs
         self._rigid_steps = 0
         self._pending = True  # the next run starts with a rigid phase
         self._engine = None  # the rigid phase's strategy, built on the first run (False: none)
+        self._start = None  # the rigid phase of a mesh in rings while it runs (_RigidStart)
 
     @property
     def phase(self) -> str:
-        return "rigid" if self.rigid is not None else "lbfgs"
+        return "rigid" if self.rigid is not None or self._start else self.finish.name
 
     def begin_run(self) -> None:
+        self.finish.begin_run()
+        if self._start is not None:  # the stage after a branch stage
+            self._start.begin()
+            return
         if not self._pending:
             return
         self._pending = False
@@ -66,6 +130,7 @@ class Hybrid(Strategy):
             except SimulationError:
                 self._engine = False  # not a rigid-panel mesh: L-BFGS alone
         if self._engine is False:
+            self._begin_rigid_start()
             return
         self.rigid = self._engine  # one engine for every run: its layout and analysis stay
         self.rigid.engine.resync(self.sim.x)
@@ -73,15 +138,45 @@ class Hybrid(Strategy):
         self._rigid_steps = 0
         self.rigid.begin_run()  # a run's stages share its energy scale (rigid_body.settled)
 
+    def _begin_rigid_start(self) -> None:
+        """From the rest state, without position targets, a mesh in rings starts on its
+        rigid-panel twin (:class:`_RigidStart`)."""
+        sim = self.sim
+        if not isinstance(self.finish, Newton) or sim._position_targets:
+            return
+        if np.abs(sim.x - sim.mesh.rest_positions).max(initial=0.0) > REST_TOL * sim.length_scale:
+            return
+        from ..coarse import rigid_twin_mesh
+
+        mesh = rigid_twin_mesh(sim.mesh, sim.pattern)
+        if mesh is not None:
+            self._start = _RigidStart(sim, mesh)
+            self._start.begin()
+
+    def _end_rigid_start(self) -> None:
+        """The cells take the rigid twin's state; the finishing strategy goes on."""
+        start, self._start = self._start, None
+        self.sim.x = np.ascontiguousarray(start.positions())
+        self.finish.restart()
+
     def step(self) -> tuple[float, float]:
+        if self._start is not None:
+            return self._start.step()
         if self.rigid is None:
-            return self.lbfgs.step()
+            return self.finish.step()
         self._rigid_steps += 1
         return self.rigid.step()
 
     def settled(self, moved: float, limit: float) -> bool:
+        if self._start is not None:
+            done = self._start.settled(moved, limit)
+            if self.sim.stage == "branch":
+                return done
+            if done or self._start.steps >= HYBRID_RIGID_MAX:
+                self._end_rigid_start()
+            return False  # the cells' own steps confirm the twin's state
         if self.rigid is None:
-            return super().settled(moved, limit)
+            return self.finish.settled(moved, limit)
         coarse = self.rigid.twin is not None
         done = self.rigid.settled(moved, limit)
         if coarse and not done and self._rigid_steps < HYBRID_RIGID_MAX:
@@ -97,10 +192,12 @@ class Hybrid(Strategy):
     def predict(self, ratio: float) -> bool:
         if not self._engine or not self._engine.predict(ratio):
             return False
-        self.lbfgs.restart()
+        self.finish.restart()
         return True
 
     def end_run(self) -> None:
+        if self._start is not None and self.sim.stage != "branch":
+            self._end_rigid_start()  # out of budget, stopped or interrupted: the cells' state
         if self._engine:
             self._engine.end_run()  # the coarse twin hands over unless the run goes on
         self._leave_rigid_phase()
@@ -110,18 +207,19 @@ class Hybrid(Strategy):
             return
         self.rigid = None
         self.sim.x = np.ascontiguousarray(self.sim.x.copy())
-        self.lbfgs.restart()
+        self.finish.restart()
 
     def targets_changed(self) -> None:
-        self.lbfgs.restart()
+        self.finish.restart()
         self._pending = True
 
     def positions_set(self) -> None:
+        self._start = None
         self._leave_rigid_phase()
         if self._engine:
             self._engine.engine.forget_ends()
         self._pending = False
-        self.lbfgs.restart()
+        self.finish.restart()
 
     def restart(self) -> None:
-        self.lbfgs.restart()
+        self.finish.restart()
