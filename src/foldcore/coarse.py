@@ -46,6 +46,13 @@ def twin_mesh(mesh, pattern):
     creases = mesh.subdivisions > 0
     if not (mesh.subdivisions[creases] > 1).any() or (mesh.segments[creases] != 1).any():
         return None
+    return thicken(pattern, mesh.thickness, hinge_width=mesh.hinge_width,
+                   subdivisions=np.where(creases, 1, 0), **_same_material(mesh, pattern))
+
+
+def _same_material(mesh, pattern) -> dict:
+    """thicken()'s ``hinge`` models and ``stiffness`` factors that rebuild ``mesh``'s
+    (factors read back from its weights over its volumes)."""
     strips = mesh.groups["bending_hinge"]
     panels = mesh.groups["rigid_panel"]
     hinge_factor = np.ones(pattern.n_edges)
@@ -53,9 +60,7 @@ def twin_mesh(mesh, pattern):
     panel_factor = np.ones(len(pattern.faces))
     panel_factor[panels.source] = panels.weights / panels.volumes
     models = np.where(mesh.hinge_model == "", None, mesh.hinge_model)  # "" on boundaries
-    return thicken(pattern, mesh.thickness, hinge_width=mesh.hinge_width,
-                   subdivisions=np.where(creases, 1, 0), hinge=models,
-                   stiffness={"hinge": hinge_factor, "panel": panel_factor})
+    return {"hinge": models, "stiffness": {"hinge": hinge_factor, "panel": panel_factor}}
 
 
 class Twin:
@@ -132,16 +137,8 @@ def rigid_twin_mesh(mesh, pattern):
 
     if not in_rings(mesh):
         return None
-    strips = mesh.groups["bending_hinge"]
-    panels = mesh.groups["rigid_panel"]
-    hinge_factor = np.ones(pattern.n_edges)
-    hinge_factor[strips.source] = strips.weights / strips.volumes
-    panel_factor = np.ones(len(pattern.faces))
-    panel_factor[panels.source] = panels.weights / panels.volumes
-    models = np.where(mesh.hinge_model == "", None, mesh.hinge_model)
     twin = thicken(pattern, mesh.thickness, hinge_width=mesh.hinge_width,
-                   subdivisions=mesh.subdivisions, hinge=models,
-                   stiffness={"hinge": hinge_factor, "panel": panel_factor})
+                   subdivisions=mesh.subdivisions, **_same_material(mesh, pattern))
     m = len(twin.points)
     if m > len(mesh.points) or not np.array_equal(twin.points, mesh.points[:m]):
         return None
