@@ -111,7 +111,7 @@ def test_cli_solver_option(tmp_path):
     assert data["converged"] and data["iterations"] <= 50
     assert abs(data["fold_angles_deg"][0] - 90.0) < 0.01
     assert set(data["timings_s"]) >= {"setup", "projection", "solve", "total"}
-    assert main(["simulate", str(src), "--solver", "newton"]) == 2
+    assert main(["simulate", str(src), "--solver", "steepest"]) == 2  # not a strategy
 
 
 @pytest.mark.parametrize("accepted, ratio, factor", [

@@ -145,7 +145,7 @@ def build_parser() -> argparse.ArgumentParser:
     sim.add_argument("--elastic-cells", type=_positive, metavar="MM",
                      help="elastic panels: cut every face into rings of cells about MM mm "
                           "long, so panels bend and stretch where the targets ask for it "
-                          "(non-rigidly-foldable patterns); runs L-BFGS; default: rigid panels")
+                          "(non-rigidly-foldable patterns); default: rigid panels")
     sim.add_argument("--fold-percent", type=float, default=100.0,
                      help="scale all target angles, -100…100 (default 100)")
     sim.add_argument("--solver", default=DEFAULT_SOLVER, choices=SOLVERS,
@@ -153,8 +153,10 @@ def build_parser() -> argparse.ArgumentParser:
                           "anderson (the same map, safeguarded Anderson acceleration), lbfgs "
                           "(L-BFGS on the same energy, K as initial Hessian) or rigid "
                           "(panels as rigid bodies, Levenberg-Marquardt; far fewer iterations "
-                          "on long panels, rigid panels only) or hybrid (rigid steps, then "
-                          "lbfgs on the paper's energy); default: " + DEFAULT_SOLVER)
+                          "on long panels, rigid panels only), hybrid (rigid steps, then "
+                          "lbfgs on the paper's energy; with --elastic-cells, rigid steps "
+                          "on rigid panels, then newton) or newton (Gauss-Newton on every "
+                          "vertex); default: " + DEFAULT_SOLVER)
     sim.add_argument("--tolerance", type=_positive, default=1e-8,
                      help="stop when the largest step is below this × pattern size")
     sim.add_argument("--max-iterations", type=int, default=10_000)

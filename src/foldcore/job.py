@@ -107,8 +107,9 @@ def simulate(path, *, thickness: float | None = None, hinge_width: float | None 
     elastic_cells : float, optional
         Elastic panels: every face cut into rings of cells about this long, mm
         (``thicken(elastic="facets", cell_size=...)``), so panels bend and
-        stretch where the targets ask for it; default rigid panels. Such a mesh
-        runs L-BFGS alone (``hybrid``'s rigid phase takes rigid panels only).
+        stretch where the targets ask for it; default rigid panels. ``hybrid``
+        folds such a mesh from rest with rigid panels first, then finishes with
+        ``newton`` (:mod:`foldcore.strategies.hybrid`).
     output, report, render, animate : path, optional
         Result FOLD, JSON report, PNG render, GIF/MP4 of the sweep from 0 to
         ``fold_percent`` in ``frames`` frames at ``fps`` (the last frame's run is
