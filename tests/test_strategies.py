@@ -104,3 +104,15 @@ def test_hybrid_on_elastic_rings_starts_rigid_and_finishes_with_newton():
     stretchy = thicken(plain, 0.5, subdivisions=2, stretch={0: 0.3})
     with pytest.raises(SimulationError, match="solver 'newton' takes"):
         Simulation(stretchy, plain, solver="newton")
+
+
+def test_newton_at_met_targets_settles_on_rounding():
+    """Every target met where the run starts (fold percent 0, at rest): E is at
+    rounding level, no step can lower it, and the run settles (before the energy
+    floor, each step rejected 17 factorisations and the run took its budget)."""
+    pattern, mesh = rings_waterbomb(10.0)
+    sim = Simulation(mesh, pattern, solver="newton")
+    sim.set_fold_percent(0.0)
+    result = sim.run(tolerance=1e-9, max_iterations=200)
+    assert result.converged and result.iterations < 200
+    assert np.abs(result.positions - mesh.rest_positions).max() <= 1e-9 * sim.length_scale
