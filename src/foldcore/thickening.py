@@ -425,8 +425,8 @@ def _elastic_cells(pattern, loops, elastic, table, cell_size) -> dict:
 
 
 def _facet_cells(pattern, loops, facets, table, cell_size) -> tuple[dict, dict]:
-    """({face: [cell loops]}, {face: rings}): each elastic facet (a face that is not a
-    quadrilateral) cut into n rings, scaled copies of its outline toward its
+    """({face: [cell loops]}, {face: ("rings", n)}): each facet (any face given rings)
+    cut into n rings, scaled copies of its outline toward its
     centroid: quads between rings, a fan of triangles at the centre. The outline
     is the panel's own (strip ends and segment points included), so cells and
     strips conform; the face must be star-shaped from its centroid. The cell

@@ -60,9 +60,9 @@ class _RigidStart:
     (:func:`foldcore.coarse.place_cells`), where the finishing strategy goes on.
     Why: a linear step on free vertices turns a panel only by stretching it, so
     a fold through large angles costs ``newton`` many steps (the FOLD project's
-    diagonal fold to 162°, 10 mm cells: over 3 000 steps, budget; with this
-    start: 12 rigid steps and a few to confirm), and the rigid model is the
-    elastic one's limit of stiff panels."""
+    diagonal fold to 162°, 10 mm cells: 3 000 steps, budget; with this start:
+    12 iterations in all), and the rigid model is the elastic one's limit of
+    stiff panels."""
 
     def __init__(self, sim, mesh):
         from ..coarse import Twin
@@ -128,7 +128,7 @@ class Hybrid(Strategy):
             try:
                 self._engine = Rigid(self.sim)
             except SimulationError:
-                self._engine = False  # not a rigid-panel mesh: L-BFGS alone
+                self._engine = False  # not a rigid-panel mesh: the finishing strategy
         if self._engine is False:
             self._begin_rigid_start()
             return

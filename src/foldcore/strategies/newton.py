@@ -4,11 +4,12 @@ Why: a mesh with elastic cells (``thicken(elastic=...)``) has no rigid
 bodies for the ``rigid`` strategy, and the local/global strategies crawl on
 it: the cells of a thin sheet are stiff in their plane and soft in bending,
 so L-BFGS from K⁻¹ needs tens of thousands of iterations and its verdict
-stalls (measured, 2-core Xeon guest, 2026-12-03, sheets of 100 mm,
-H = 0.5 mm, every face in rings, tolerance 1e-8: Origami Simulator's square
-twist at 30 %, 20 mm cells, 9 198 L-BFGS iterations, 2.1 s; the crane at 30 %,
-10 mm cells, 40 000 iterations, 39 s, stalled. This strategy: 25 steps, 0.47 s,
-and 33 steps, 2.0 s, converged, the same states to 1e-6°).
+stalls (measured, 2-core Xeon guest, load 1.4, 2026-12-03, sheets of 100 mm,
+H = 0.5 mm, every face in rings, from rest, tolerance 1e-8: Origami
+Simulator's square twist at 30 %, 20 mm cells: L-BFGS 9 198 iterations,
+1.9 s, this strategy 24 steps, 0.38 s; the crane at 30 %, 10 mm cells:
+L-BFGS 40 000 iterations, 36 s, stalled, this strategy 34 steps, 2.1 s,
+converged; the same states to 1e-5°).
 
 The energy is the paper's, E(x) = Σ_e w_e ‖C x_e − P_e(x)‖² (+ pins), P_e the
 element's projection: its target shape, best rotated (:mod:`elements`). Since
