@@ -26,7 +26,9 @@ Per row: θ* (degrees), iterations, verdict, wall time (median of RUNS warm
 runs after one warm-up, interleaved across rows), the largest miss on the
 straight and on the zig-zag creases (degrees) and their ratio. Run:
 ``.venv/bin/python bench/os_miura.py`` (a few minutes); writes
-bench/results/os_miura.json and prints the README table.
+bench/results/os_miura.json and .png (the flat fold's misses against the
+zig-zag miss / cos γ line, and each case's time) and prints the README table;
+``--plot`` redraws the PNG from the JSON.
 """
 from __future__ import annotations
 
@@ -112,10 +114,49 @@ def main() -> None:
     out = {"pattern": f"Miura {N} x {M}, a = b = {A} mm, gamma = {GAMMA}",
            "tolerance": 1e-9, "budget": BUDGET, "runs": RUNS, "cases": cases,
            "load_before": load, "load_after": os.getloadavg(), "machine": machine_meta()}
-    (ROOT / "bench" / "results" / "os_miura.json").write_text(json.dumps(out, indent=1))
+    results = ROOT / "bench" / "results" / "os_miura.json"
+    results.write_text(json.dumps(out, indent=1))
+    plot(out, results.with_suffix(".png"))
     print(markdown_table(["case", "tilt (°)", "θ* (°)", "verdict", "iterations", "s",
                           "straight miss (°)", "zig-zag miss (°)", "ratio"], rows))
 
 
+def plot(out: dict, path: Path) -> None:
+    """Flat-fold misses: straight against zig-zag (with the singularity's 1 / cos γ
+    line), and the time of every case."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    flat = [c for c in out["cases"] if c["tilt_deg"] == 90.0]
+    fig, (left, right) = plt.subplots(1, 2, figsize=(11, 4.2))
+    zigzag = np.array([c["runs"][-1]["zigzag_miss_deg"] for c in flat])
+    straight = np.array([c["runs"][-1]["straight_miss_deg"] for c in flat])
+    line = np.linspace(0.0, zigzag.max() * 1.1, 20)
+    left.plot(line, line / np.cos(np.radians(GAMMA)), "k--",
+              label=f"zig-zag miss / cos γ (γ = {GAMMA:g}°)")
+    for c, z, st in zip(flat, zigzag, straight):
+        left.plot(z, st, "o", label=f"{c['label']} (θ* = {c['runs'][-1]['pivot_deg']:.0f}°)")
+    left.axhline(0.5, color="tab:red", lw=0.8)
+    left.text(0.02, 0.7, "target 0.5°", color="tab:red", fontsize=8)
+    left.set(xlabel="zig-zag crease miss at flat (°)", ylabel="straight crease miss (°)",
+             title="Flat fold: the straight creases amplify the zig-zag miss")
+    left.legend(fontsize=7)
+    labels = [f"{c['label']}\ntilt {c['tilt_deg']:g}°" for c in out["cases"]]
+    right.barh(range(len(labels)), [c["median_seconds"] for c in out["cases"]])
+    right.axvline(0.5, color="tab:red", lw=0.8)
+    right.set_yticks(range(len(labels)), labels, fontsize=7)
+    right.set(xlabel="wall time to converged (s, median)", title="Time (target 0.5 s)")
+    fig.suptitle(f"{out['pattern']}, every crease driven; {out['machine']['machine']}, "
+                 f"load {out['load_before'][0]:.1f}", fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+
+
 if __name__ == "__main__":
-    main()
+    if "--plot" in sys.argv[1:]:
+        results = ROOT / "bench" / "results" / "os_miura.json"
+        plot(json.loads(results.read_text()), results.with_suffix(".png"))
+    else:
+        main()
