@@ -186,7 +186,8 @@ def fold(path, **options) -> Fold:
                              callback=o["callback"])
         except KeyboardInterrupt:  # the last complete iterate is a result too
             result, interrupted = sim.result(False, "interrupted"), True
-    summary, said = run_summary(result, loaded.pattern, source, o["fold_percent"])
+    summary, said = run_summary(result, loaded.pattern, source, o["fold_percent"],
+                                elastic=bool(mesh.elastic))
     for text in said:
         warnings.warn(text, RunWarning, stacklevel=3)
     settings = {"pattern": source, **{k: o[k] for k in ("fold_percent", "solver", "tolerance",

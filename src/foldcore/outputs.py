@@ -80,10 +80,12 @@ def _iteration_cost(result) -> dict:
 MISS_WARNING_DEG = 1.0
 
 
-def run_summary(result, pattern, source: str, fold_percent: float) -> tuple[str, list[str]]:
+def run_summary(result, pattern, source: str, fold_percent: float,
+                elastic: bool = False) -> tuple[str, list[str]]:
     """The one-line summary of a run (verdict, iterations, time, the driven creases'
     miss) and the warnings it calls for: nothing driven, or converged with targets
-    missed by more than :data:`MISS_WARNING_DEG`."""
+    missed by more than :data:`MISS_WARNING_DEG` (``elastic``: the mesh has elastic
+    panels, so the warning does not suggest them)."""
     entries = actuation_entries(result, pattern)
     driven, worst = len(entries["creases"]), entries["largest_miss_deg"]
     verdict = "converged" if result.converged else f"not converged ({result.reason})"
@@ -103,9 +105,12 @@ def run_summary(result, pattern, source: str, fold_percent: float) -> tuple[str,
                      f"their targets by more than {MISS_WARNING_DEG:g}° (up to {worst:.3g}°"
                      + (f"; {wrong} folded to the other side" if wrong else "") + "): "
                      "the model binds there — these targets cannot all be met at once "
-                     "(with rigid panels: a pattern that is not rigidly foldable; "
-                     "--elastic-cells lets the panels bend); the report's actuation lists "
-                     "each crease (README: Files made for Origami Simulator)")
+                     + ("(with elastic panels: meeting them needs the faces to stretch, or "
+                        "hinge stiffness factors above the panels')" if elastic else
+                        "(with rigid panels: a pattern that is not rigidly foldable; "
+                        "--elastic-cells lets the panels bend)")
+                     + "; the report's actuation lists each crease (README: Files made "
+                     "for Origami Simulator)")
     return line, warns
 
 
