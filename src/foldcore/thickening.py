@@ -470,9 +470,14 @@ def _nearest_cell(pattern, f: int, cells: list, table) -> int:
     sides = [(face[i], face[(i + 1) % len(face)]) for i in range(len(face))]
     creased = [s for s in sides if pattern.assignments[_edge_of(pattern, *s)] != "B"]
     u, v = (creased or sides)[0]
-    target = 0.5 * (pattern.vertices[u] + pattern.vertices[v])
-    centres = np.array([np.mean([table.coords[i] for i in c], axis=0) for c in cells])
-    return int(np.argmin(np.linalg.norm(centres - target, axis=1)))
+    return _nearest(cells, table.coords, 0.5 * (pattern.vertices[u] + pattern.vertices[v]))
+
+
+def _nearest(cells: list, coords, point) -> int:
+    """Index of the cell (a loop of point ids into ``coords``) whose footprint centroid
+    is nearest ``point`` (2,), mm."""
+    centres = np.array([np.mean([coords[i] for i in c], axis=0) for c in cells])
+    return int(np.argmin(np.linalg.norm(centres - point, axis=1)))
 
 
 def _split_elastic(pattern, elastic) -> tuple[dict, dict, dict]:
@@ -766,9 +771,7 @@ def _crease_panels(pattern, points, cells, panels, panel_of_face) -> np.ndarray:
         middle = pattern.vertices[pattern.edges[e]].mean(axis=0)
         for side, f in enumerate(faces[e]):
             if f >= 0 and int(f) in cells:
-                centres = np.array([points[c].mean(axis=0) for c in cells[int(f)]])
-                nearest = int(np.argmin(np.linalg.norm(centres - middle, axis=1)))
-                out[e, side] = panel_of_face[f] + nearest
+                out[e, side] = panel_of_face[f] + _nearest(cells[int(f)], points, middle)
     return out
 
 

@@ -35,7 +35,7 @@ from ..errors import SimulationError
 from . import Strategy
 from .lbfgs import Lbfgs
 from .newton import Newton
-from .rigid import REST_TOL, Rigid
+from .rigid import Rigid, at_rest
 
 HYBRID_RIGID_MAX = 1_000  # rigid-body steps at most per run (Miura 20 × 20, one crease driven: 206)
 HYBRID_RIGID_TOL = 1e-10  # relative step below which the rigid phase ends (even at tolerance 0)
@@ -142,9 +142,7 @@ class Hybrid(Strategy):
         """From the rest state, without position targets, a mesh in rings starts on its
         rigid-panel twin (:class:`_RigidStart`)."""
         sim = self.sim
-        if not isinstance(self.finish, Newton) or sim._position_targets:
-            return
-        if np.abs(sim.x - sim.mesh.rest_positions).max(initial=0.0) > REST_TOL * sim.length_scale:
+        if not isinstance(self.finish, Newton) or not at_rest(sim, sim.x):
             return
         from ..coarse import rigid_twin_mesh
 

@@ -35,6 +35,14 @@ REST_TOL = 1e-9  # relative distance from the rest positions that counts as the 
 TWIN_STALL = 1e-10  # relative accepted step of the twin that hands over unsettled
 
 
+def at_rest(sim, x: np.ndarray) -> bool:
+    """Whether ``sim`` has no position targets and ``x`` (N, 3) mm is its mesh's rest
+    state, within ``REST_TOL`` × the size (a panels' fit rounds it): where a run
+    may start on a twin mesh."""
+    gap = np.abs(x - sim.mesh.rest_positions).max(initial=0.0)
+    return not sim._position_targets and gap <= REST_TOL * sim.length_scale
+
+
 class Rigid(Strategy):
     """One Levenberg–Marquardt iteration per :meth:`step` (rejected steps count)."""
 
@@ -91,11 +99,8 @@ class Rigid(Strategy):
 
     def _at_rest(self) -> bool:
         """Whether the run starts the coarse phase: enabled, no position targets, and
-        the engine's positions at the rest state (within ``REST_TOL`` × the size:
-        the panels' fit rounds them)."""
-        sim = self.sim
-        gap = np.abs(self.engine.x - sim.mesh.rest_positions).max(initial=0.0)
-        return COARSE_START and not sim._position_targets and gap <= REST_TOL * sim.length_scale
+        the engine's positions at the rest state (:func:`at_rest`)."""
+        return COARSE_START and at_rest(self.sim, self.engine.x)
 
     def _coarse_twin(self):
         """The mesh's coarse twin (:class:`foldcore.coarse.Twin`), built once; None
