@@ -41,7 +41,7 @@ largest, where the steps are rounding.
 
 Cost per step: one assembly of H (NumPy, per element size) and one sparse
 Cholesky (CHOLMOD, else SciPy), plus 1 + ``CORRECTIONS`` local steps and K
-solves per trial. Units: mm.
+solves per trial (the accepted trial's projections serve the next step). Units: mm.
 """
 from __future__ import annotations
 
@@ -88,8 +88,11 @@ class Newton(Strategy):
         self.energy_floor = (sim.system.reference_weight * sim.mesh.n_vertices
                              * (ROUNDING * sim.length_scale) ** 2)
 
+        self._at = None  # the accepted trial's projections, reused by the next step
+
     def restart(self) -> None:
         self.lam, self._moves, self.energy_max = LAMBDA_START, [], 0.0
+        self._at = None
 
     def begin_run(self) -> None:
         self._moves, self.energy_max = [], 0.0
@@ -97,19 +100,19 @@ class Newton(Strategy):
     def step(self) -> tuple[float, float]:
         sim = self.sim
         x = sim.x
-        energy, rhs = sim.local_step(x)
+        energy, rhs, targets = self._projections(x)
         self.energy_max = max(self.energy_max, energy)
         noise = ROUNDING * self.energy_max + self.energy_floor  # changes that count as none
         gradient = (sim.system.apply(x) - rhs).ravel()
-        hessian, scale = self._hessian()
+        hessian, scale = self._hessian(targets)
         while True:
             delta = Factor(hessian + sp.diags(self.lam * scale), sim.system.factor.backend) \
                 .solve(-gradient).reshape(-1, 3)
             if not sim._position_targets:
                 delta = _without_rigid_motion(delta, x)
             trial = self._corrected(x + delta)
-            trial_energy, _ = sim.local_step(trial)
-            if trial_energy < energy or trial_energy <= energy + noise:
+            trial_energy, trial_rhs = sim.local_step(trial)
+            if trial_energy <= energy + noise:
                 self.accepted, self.undamped = True, self.lam <= LAMBDA_SETTLED
                 self.lam = max(self.lam / LAMBDA_DOWN, LAMBDA_MIN)
                 break
@@ -121,8 +124,19 @@ class Newton(Strategy):
         moved = float(np.abs(trial - x).max())
         self._moves.append(moved)
         self.energy = trial_energy
+        self._at = (trial, trial_energy, trial_rhs.copy(), sim._targets.copy(),
+                    sim.system.version)
         sim.x = trial
         return energy, moved
+
+    def _projections(self, x: np.ndarray):
+        """(E, b, slot targets) at ``x``: kept from the step that accepted ``x`` while
+        K is the same (a stop that closed there refactors it), else projected anew."""
+        at, self._at = self._at, None
+        if at is not None and at[0] is x and at[4] == self.sim.system.version:
+            return at[1], at[2], at[3]
+        energy, rhs = self.sim.local_step(x)
+        return energy, rhs, self.sim._targets
 
     def settled(self, moved: float, limit: float) -> bool:
         """An accepted step, damped at most ``LAMBDA_SETTLED``, within ``limit`` mm,
@@ -144,13 +158,13 @@ class Newton(Strategy):
             x = self.sim.global_step(rhs)
         return x
 
-    def _hessian(self):
-        """(H, diagonal of K ⊗ I₃) at the current projections (``sim.local_step`` just ran):
+    def _hessian(self, targets: np.ndarray):
+        """(H, diagonal of K ⊗ I₃) at the projections ``targets`` (nnz, 3) mm:
         H = K ⊗ I₃ − Σ w Q Qᵀ, (3N, 3N) CSC, degrees of freedom vertex-major."""
         sim = self.sim
         base = sp.kron(sim.system._with_pins(), sp.identity(3), format="csr")
         rows, cols, vals = [], [], []
-        for ids, weights, basis in self._rotation_bases():
+        for ids, weights, basis in self._rotation_bases(targets):
             n, m = ids.shape
             dof = (3 * ids[:, :, None] + np.arange(3)).reshape(n, 3 * m)
             rows.append(np.repeat(dof, 3 * m, axis=1).ravel())
@@ -163,14 +177,15 @@ class Newton(Strategy):
                                  shape=(size, size))
         return (base + low_rank).tocsc(), base.diagonal()
 
-    def _rotation_bases(self):
+    def _rotation_bases(self, all_targets: np.ndarray):
         """Per group and element size m: vertex ids (n, m), weights (n,) and an
-        orthonormal basis (n, 3m, 3) of the rotations of each element's projection."""
+        orthonormal basis (n, 3m, 3) of the rotations of each element's projection
+        (``all_targets``: every group's slot targets, mm)."""
         sim = self.sim
         for run, weights in zip(sim._runs, sim.system.weights):
             group = run.group
             sizes = np.diff(group.indptr)
-            targets = sim._targets[run.slots]
+            targets = all_targets[run.slots]
             for m in np.unique(sizes):
                 sel = np.flatnonzero(sizes == m)
                 slots = group.indptr[sel][:, None] + np.arange(m)
