@@ -39,8 +39,8 @@ longer, so the distance left (the geometric tail of the steps) is within the
 limit too — or, on a compatible fold, E down to tolerance² of the run's
 largest, where the steps are rounding.
 
-Cost per step: one assembly of H (NumPy, per element size) and one sparse
-Cholesky (CHOLMOD, else SciPy), plus 1 + ``CORRECTIONS`` local steps and K
+Cost per step: one assembly of H into a fixed pattern (:class:`HessianPattern`)
+and one sparse Cholesky per trial (CHOLMOD refactors in place, else SciPy), plus 1 + ``CORRECTIONS`` local steps and K
 solves per trial (the accepted trial's projections serve the next step). Units: mm.
 """
 from __future__ import annotations
@@ -89,6 +89,8 @@ class Newton(Strategy):
                              * (ROUNDING * sim.length_scale) ** 2)
 
         self._at = None  # the accepted trial's projections, reused by the next step
+        self._pattern = None  # HessianPattern of the current K
+        self._factor = None  # Factor of H + λ D, refactored in place while the pattern holds
 
     def restart(self) -> None:
         self.lam, self._moves, self.energy_max = LAMBDA_START, [], 0.0
@@ -104,10 +106,9 @@ class Newton(Strategy):
         self.energy_max = max(self.energy_max, energy)
         noise = ROUNDING * self.energy_max + self.energy_floor  # changes that count as none
         gradient = (sim.system.apply(x) - rhs).ravel()
-        hessian, scale = self._hessian(targets)
+        hessian = self._hessian(targets)
         while True:
-            delta = Factor(hessian + sp.diags(self.lam * scale), sim.system.factor.backend) \
-                .solve(-gradient).reshape(-1, 3)
+            delta = self._solve(hessian, -gradient).reshape(-1, 3)
             if not sim._position_targets:
                 delta = _without_rigid_motion(delta, x)
             trial = self._corrected(x + delta)
@@ -158,24 +159,27 @@ class Newton(Strategy):
             x = self.sim.global_step(rhs)
         return x
 
-    def _hessian(self, targets: np.ndarray):
-        """(H, diagonal of K ⊗ I₃) at the projections ``targets`` (nnz, 3) mm:
-        H = K ⊗ I₃ − Σ w Q Qᵀ, (3N, 3N) CSC, degrees of freedom vertex-major."""
+    def _hessian(self, targets: np.ndarray) -> np.ndarray:
+        """Values of H = K ⊗ I₃ − Σ w Q Qᵀ at the projections ``targets`` (nnz, 3) mm, in
+        the fixed pattern of :class:`HessianPattern` (built anew when K changes)."""
         sim = self.sim
-        base = sp.kron(sim.system._with_pins(), sp.identity(3), format="csr")
-        rows, cols, vals = [], [], []
-        for ids, weights, basis in self._rotation_bases(targets):
-            n, m = ids.shape
-            dof = (3 * ids[:, :, None] + np.arange(3)).reshape(n, 3 * m)
-            rows.append(np.repeat(dof, 3 * m, axis=1).ravel())
-            cols.append(np.tile(dof, (1, 3 * m)).ravel())
-            vals.append((-weights[:, None, None]
-                         * np.einsum("nik,njk->nij", basis, basis)).ravel())
-        size = base.shape[0]
-        low_rank = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows),
-                                                         np.concatenate(cols))),
-                                 shape=(size, size))
-        return (base + low_rank).tocsc(), base.diagonal()
+        if self._pattern is None or self._pattern.version != sim.system.version:
+            blocks = [ids for ids, _, _ in self._rotation_bases(targets)]
+            self._pattern = HessianPattern(sim.system, blocks)
+            self._factor = None
+        blocks = [-weights[:, None, None] * np.matmul(basis, basis.transpose(0, 2, 1))
+                  for _, weights, basis in self._rotation_bases(targets)]
+        return self._pattern.values(blocks)
+
+    def _solve(self, values: np.ndarray, rhs: np.ndarray) -> np.ndarray:
+        """(H + λ D)⁻¹ rhs, D the diagonal of K ⊗ I₃; the factor keeps its symbolic
+        analysis while the pattern stays (CHOLMOD ``cholesky_inplace``)."""
+        matrix = self._pattern.matrix(values, self.lam)
+        if self._factor is None:
+            self._factor = Factor(matrix, self.sim.system.factor.backend, stored="lower")
+        else:
+            self._factor.refactor(matrix)
+        return self._factor.solve(rhs)
 
     def _rotation_bases(self, all_targets: np.ndarray):
         """Per group and element size m: vertex ids (n, m), weights (n,) and an
@@ -197,6 +201,65 @@ class Newton(Strategy):
                                   np.stack([-p[..., 1], p[..., 0], zero], axis=2)], axis=3)
                 basis, _ = np.linalg.qr(turns.reshape(len(sel), 3 * int(m), 3))
                 yield group.indices[slots], weights[sel], basis
+
+
+class HessianPattern:
+    """The fixed sparsity pattern of H = K ⊗ I₃ − Σ w Q Qᵀ: its lower triangle in CSC,
+    and where each entry of K ⊗ I₃ and of each element's (3m × 3m) block adds in.
+
+    Built once per K (``system.version``), so a step assembles H by one
+    ``bincount`` instead of SciPy's COO → CSR → sum → CSC conversions, and the
+    pattern, explicit zeros kept, is the same at every step: CHOLMOD reuses its
+    symbolic analysis. Measured (2-core Xeon guest, 2026-12-03, cProfile): on
+    Origami Simulator's Miura 12 × 13 in graded arc hinges (16 944 unknowns)
+    the assembly fell from 55 to 14 ms per step and a factorisation from 40 to
+    30 ms; whole runs, 3 interleaved rounds against the SciPy assembly: that
+    Miura flat 3.25–3.41 → 1.73–1.78 s, the crane at 30 % in 10 mm rings
+    2.05–2.26 → 1.06–1.11 s, the same 26 and 34 steps, angles equal to 1e-9°.
+
+    Parameters
+    ----------
+    system : foldcore.system.System
+        Its K with the pins (``_with_pins``), N × N.
+    blocks : list of (n, m) int arrays
+        Vertex ids of each run of elements of size m, in the order their
+        values will be given to :meth:`values`.
+    """
+
+    def __init__(self, system, blocks):
+        self.version = system.version
+        base = sp.kron(system._with_pins(), sp.identity(3), format="coo")
+        rows, cols = [base.row], [base.col]
+        for ids in blocks:
+            n, m = ids.shape
+            dof = (3 * ids[:, :, None] + np.arange(3)).reshape(n, 3 * m)
+            rows.append(np.repeat(dof, 3 * m, axis=1).ravel())
+            cols.append(np.tile(dof, (1, 3 * m)).ravel())
+        rows, cols = np.concatenate(rows), np.concatenate(cols)
+        self.lower = rows >= cols  # the entries CHOLMOD reads
+        size = base.shape[0]
+        keys, self.slot = np.unique(cols[self.lower].astype(np.int64) * size
+                                    + rows[self.lower], return_inverse=True)
+        self.indices = (keys % size).astype(np.int32)
+        self.indptr = np.searchsorted(keys // size, np.arange(size + 1)).astype(np.int32)
+        self.shape = (size, size)
+        self.base_values = base.data
+        self.scale = base.tocsr().diagonal()
+        self.diagonal = self.indptr[:-1]  # the first entry of each lower column: its diagonal
+        if not np.array_equal(self.indices[self.diagonal], np.arange(size)):
+            raise SimulationError("solver 'newton': a vertex without elements (K has a zero "
+                                  "diagonal)")
+
+    def values(self, blocks) -> np.ndarray:
+        """(nnz,) values of H from each run's (n, 3m, 3m) blocks (order of ``blocks``)."""
+        entries = np.concatenate([self.base_values] + [b.ravel() for b in blocks])
+        return np.bincount(self.slot, weights=entries[self.lower], minlength=len(self.indices))
+
+    def matrix(self, values: np.ndarray, damping: float):
+        """Lower triangle of H + ``damping`` × D (D the diagonal of K ⊗ I₃), CSC."""
+        data = values.copy()
+        data[self.diagonal] += damping * self.scale
+        return sp.csc_matrix((data, self.indices, self.indptr), shape=self.shape)
 
 
 def _without_rigid_motion(delta: np.ndarray, x: np.ndarray) -> np.ndarray:
