@@ -17,7 +17,7 @@ from .errors import PatternError
 from .pattern import CreasePattern
 
 __all__ = ["degree4_vertex", "single_vertex", "waterbomb", "miura", "miura_edge_kinds",
-           "miura_fold_angles", "miura_one_crease", "single_hinge", "grid",
+           "miura_fold_angles", "miura_flat_widths", "miura_one_crease", "single_hinge", "grid",
            "degree4_assignments"]
 
 PEHRSON_SECTORS = (135.0, 90.0, 45.0, 90.0)
@@ -317,6 +317,47 @@ def miura_fold_angles(n: int, m: int, gamma: float, tilt: float) -> np.ndarray:
     zigzag, straight = kinematics.miura_angles_deg(gamma, tilt)
     sign = np.where(np.array(_miura_assignments(n, m)) == "M", -1.0, 1.0)
     return sign * np.select([kinds == "zigzag", kinds == "straight"], [zigzag, straight], np.nan)
+
+
+def miura_flat_widths(n: int, m: int, width: float) -> np.ndarray:
+    """(E,) hinge widths (mm) with which a thick :func:`miura` ``(n, m)`` folds
+    exactly flat with arc hinges (``thicken(..., hinge="arc")``); NaN on the boundary.
+
+    Folded flat, a degree-4 vertex stacks its four panels in four layers. The
+    crease opposite its odd crease (the one whose M/V differs from the other
+    three) wraps around the other three, so its arc radius must be the sum of
+    theirs; an arc hinge of width W bent 180° has radius W / π (its panels 2W / π
+    apart). With equal hinges the loop around the vertex misses by two layers
+    (its first and third panel would share one) and the sheet stops short of
+    flat (``bench/os_miura.py``). In a Miura the odd crease is a straight one,
+    and every straight edge is the wrapping crease at one of its ends and the
+    odd one at the other, so along each straight line the widths grow by twice
+    the zig-zag width per vertex: zig-zag edges get ``width``, the k-th edge of
+    a straight line (k = 0 … n − 1, counted from the end where it wraps: the
+    left end on odd rows, the right one on even rows) ``(1 + 2k) · width``.
+    The axis hinge cannot use this: at 180° it pivots about its inner surface
+    whatever its width (panels H apart).
+
+    Parameters
+    ----------
+    n, m : int
+        Facets along x and y.
+    width : float, mm
+        Zig-zag hinge width; at least π H / 2 (Eq. 7's width) so that an arc
+        bent flat keeps a non-negative inner radius.
+
+    Returns
+    -------
+    (E,) float, mm, in the pattern's edge order.
+    """
+    _check_lattice("miura", n, m)
+    _check_positive(width=width)
+    kinds = miura_edge_kinds(n, m)
+    i, j = np.tile(np.arange(n), m + 1), np.arange(m + 1).repeat(n)  # a-edges (i, j)
+    k = np.where(j % 2 == 1, i, n - 1 - i)
+    straight = (1.0 + 2.0 * k) * width
+    widths = np.concatenate([straight, np.full((n + 1) * m, float(width))])
+    return np.where(kinds == "boundary", np.nan, widths)
 
 
 def miura_one_crease(n: int, m: int, a: float = 20.0, b: float = 20.0, gamma: float = 60.0,

@@ -1,0 +1,102 @@
+"""Thick Miura folded flat: the layers a degree-4 vertex stacks (issue 17).
+
+Flat, a degree-4 vertex stacks its four panels in four layers, and the crease
+opposite its odd crease (M/V unlike the other three) wraps around the other
+three: its arc radius must be the sum of theirs. Arc hinges (radius W / π at
+180°) of equal width leave the loop two layers short, so the sheet cannot
+reach flat; widths that satisfy the sum at every vertex
+(:func:`foldcore.patterns.miura_flat_widths` for a Miura) fold it exactly.
+
+Bounds: a compatible flat state is reached to the run's tolerance, 1e-8 ×
+size; over a hinge of width W ≥ 0.785 mm that is a fold angle within
+2 × 1e-8 × 100 mm / W ≈ 1.5e-4°, so 1e-3° per crease. The incompatible ones
+must miss by more than 1° on their straight creases (measured 2.5–6°; the
+singular flat state amplifies the miss on them, :mod:`bench/os_miura.py`).
+"""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from foldcore import patterns
+from foldcore.simulation import Simulation
+from foldcore.thickening import thicken
+
+GAMMA = 84.0  # degrees, Origami Simulator's Miura
+SECTORS = [GAMMA, 180.0 - GAMMA, 180.0 - GAMMA, GAMMA]  # creases 1, 3 collinear (straight)
+H = 0.5  # mm
+EXACT = 1e-3  # degrees
+SHORT = 1.0  # degrees
+
+
+def fold_flat(pattern, thickness):
+    """(E,) achieved fold angles (degrees) of ``pattern`` thickened with arc hinges."""
+    mesh = thicken(pattern, thickness, hinge="arc")
+    result = Simulation(mesh, pattern, solver="newton").run(tolerance=1e-8, max_iterations=200)
+    return result.fold_angles_deg
+
+
+def flat_vertex(widths):
+    mv = patterns.degree4_assignments(SECTORS, "B")
+    targets = [180.0 if a == "V" else -180.0 for a in mv]
+    return patterns.single_vertex(SECTORS, mv, targets, radius=50.0, widths=widths), targets
+
+
+def test_wrapping_crease_as_wide_as_the_other_three_folds_a_vertex_flat():
+    width = np.pi / 2 * H  # Eq. 7: the arc's inner radius is 0 at 180°
+    mv = patterns.degree4_assignments(SECTORS, "B")
+    odd = [k for k in range(4) if mv.count(mv[k]) == 1][0]
+    wrap = (odd + 2) % 4
+    widths = [3 * width if k == wrap else width for k in range(4)]
+    pattern, targets = flat_vertex(widths)
+    miss = np.abs(fold_flat(pattern, H)[:4] - targets)
+    assert miss.max() < EXACT
+    pattern, targets = flat_vertex([width] * 4)
+    miss = np.abs(fold_flat(pattern, H)[:4] - targets)
+    assert miss[[0, 2]].min() > SHORT  # the straight pair, creases 1 and 3
+
+
+def test_miura_flat_widths_close_every_vertex():
+    """At each interior vertex the crease opposite the odd one is as wide as the
+    other three together (checked from the M/V, not from the formula)."""
+    n, m, width = 5, 4, 1.5
+    pattern = patterns.miura(n, m, a=20.0, b=20.0, gamma=GAMMA)
+    widths = patterns.miura_flat_widths(n, m, width)
+    kinds = patterns.miura_edge_kinds(n, m)
+    assert np.isnan(widths[kinds == "boundary"]).all()
+    assert np.allclose(widths[kinds == "zigzag"], width)
+    at_vertex = {}
+    for e, (u, v) in enumerate(pattern.edges):
+        if kinds[e] != "boundary":
+            at_vertex.setdefault(u, []).append(e)
+            at_vertex.setdefault(v, []).append(e)
+    checked = 0
+    for vertex, edges in at_vertex.items():
+        if len(edges) != 4:
+            continue
+        mv = [pattern.assignments[e] for e in edges]
+        odd = [e for e, a in zip(edges, mv) if mv.count(a) == 1][0]
+        wrap = [e for e in edges if kinds[e] == kinds[odd] and e != odd][0]
+        others = sum(widths[e] for e in edges if e != wrap)
+        assert widths[wrap] == pytest.approx(others)
+        checked += 1
+    assert checked == (n - 1) * (m - 1)
+
+
+def test_graded_miura_folds_flat_and_equal_one_does_not():
+    n, m = 4, 2
+    thickness = 0.2
+    angles = patterns.miura_fold_angles(n, m, GAMMA, 90.0)
+    straight = patterns.miura_edge_kinds(n, m) == "straight"
+    base = patterns.miura(n, m, a=20.0, b=20.0, gamma=GAMMA,
+                          width=np.pi / 2 * thickness).replace(fold_angles=angles)
+    graded = base.replace(widths=patterns.miura_flat_widths(n, m, np.pi / 2 * thickness))
+    miss = np.abs(fold_flat(graded, thickness) - angles)
+    assert np.nanmax(miss) < EXACT
+    miss = np.abs(fold_flat(base, thickness) - angles)
+    assert miss[straight].min() > SHORT
+
+
+def test_miura_flat_widths_refuses_a_bad_width():
+    with pytest.raises(Exception, match="width"):
+        patterns.miura_flat_widths(3, 3, 0.0)
