@@ -16,8 +16,9 @@ bench/results/real_patterns.json and prints the README table.
 
 ``--elastic``: the files whose rigid panels bind, again with elastic panels
 (``elastic_cells`` = CELL mm: every face in rings of cells, the command line's
-``--elastic-cells``), at most ELASTIC_BUDGET iterations (L-BFGS alone: such a
-mesh has no rigid phase); writes bench/results/real_patterns_elastic.json.
+``--elastic-cells``), at most ELASTIC_BUDGET iterations (the default
+``hybrid``: the rigid-panel twin from rest, then ``newton``); writes
+bench/results/real_patterns_elastic.json.
 """
 from __future__ import annotations
 

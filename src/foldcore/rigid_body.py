@@ -442,16 +442,16 @@ class RigidBodySolver:
         """Fixed CSC pattern of JᵀJ (rigid_normal's module docstring): indptr, indices,
         the slot of each diagonal entry; and a Factor to be refilled every step.
 
-        Blocks beside the strips': each column's diagonal, each moving panel's
-        6 × 6 block (position targets), each M/V crease's two panel rotations.
+        Blocks beside the strips': each moving panel's 6 × 6 block (position
+        targets), each M/V crease's two panel rotations; every column's
+        diagonal comes with the pattern (first in its column).
         """
         n = self.n_unknowns
         width = rigid_normal.MAX_LOCAL
         panel = self.panel_col[self.panel_col >= 0]
         left, right = self.panel_col[self.mv_left], self.panel_col[self.mv_right]
         both = (left >= 0) & (right >= 0)
-        blocks = [(np.arange(n)[:, None], 1),
-                  (panel[:, None] + np.arange(6), 6),
+        blocks = [(panel[:, None] + np.arange(6), 6),
                   (np.column_stack([left[both, None] + np.arange(3),
                                     right[both, None] + np.arange(3)]), 6)]
         cols, n_loc, kind = [self.loc_cols], [self.n_loc], [self._loc_kind]
@@ -466,8 +466,7 @@ class RigidBodySolver:
         # 32-bit indices, as CHOLMOD's int interface and SciPy take them: no copy per step
         index = np.int32 if indptr[-1] < np.iinfo(np.int32).max else np.int64
         self.csc_indptr, self.csc_indices = indptr.astype(index), indices.astype(index)
-        column = np.repeat(np.arange(n), np.diff(self.csc_indptr))
-        self.diag_slot = np.flatnonzero(self.csc_indices == column)
+        self.diag_slot = self.csc_indptr[:-1].astype(np.int64)  # first in each column
         self._normal_factor = None
 
     def _map_pattern(self) -> None:
