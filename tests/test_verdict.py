@@ -220,3 +220,24 @@ def test_a_run_from_its_own_equilibrium_converges_at_once(solver):
     assert again.iterations - first.iterations <= PROBE_STEPS
     allowed = np.rad2deg(2.0 * 1e-10 * sim.length_scale / 5.0)  # H = 5 mm
     np.testing.assert_allclose(again.fold_angles_deg, first.fold_angles_deg, atol=allowed)
+
+
+def test_a_converged_binding_fold_is_within_the_tolerance_of_its_equilibrium():
+    """A binding equilibrium (a thick Miura 6 × 6 driven flat: the loop around each
+    vertex cannot close, tests/test_flat_fold.py) has a residual left, where a
+    Gauss–Newton step makes the last step's Jacobian blind to what is left
+    (J₀ᵀ r(x₀ + v) ≈ 0): the simplified correction measured with it stopped the
+    run after 92 iterations 2.2e-3 mm from the equilibrium, 18 000 × the limit.
+    Converged at tolerance 1e-9, the positions must be within the distance two
+    runs each within tolerance × size of the equilibrium can be apart (2 × the
+    limit; measured 2.3 ×, so 3 ×) of the run at 1e-13."""
+    n, gamma = 6, 84.0
+    angles = patterns.miura_fold_angles(n, n, gamma, 90.0)
+    pattern = patterns.miura(n, n, a=A, b=A, gamma=gamma).replace(fold_angles=angles)
+    mesh = thicken(pattern, 0.01 * A)
+    loose = Simulation(mesh, pattern).run(tolerance=1e-9, max_iterations=3000)
+    sim = Simulation(mesh, pattern)
+    tight = sim.run(tolerance=1e-13, max_iterations=3000)
+    assert loose.converged and tight.converged
+    limit = 1e-9 * sim.length_scale
+    assert np.abs(loose.positions - tight.positions).max() <= 3 * limit
