@@ -90,10 +90,11 @@ class Twin:
         self._k = mesh.subdivisions[self._edge].astype(float)
 
     def mirror(self, sim) -> None:
-        """The twin's targets (``sim``'s fold targets and fold percent, through its own
+        """The twin's stage, targets (``sim``'s fold targets and fold percent, through its own
         :meth:`Simulation._apply_fold_targets`) and floors (crease by crease: a strip
         carries its crease's floor over its k sub-strips) from ``sim``'s."""
         twin = self.sim
+        twin.stage = sim.stage  # the stage too (a branch stage takes no extrapolation)
         twin._fold_targets, twin._percent = sim._fold_targets.copy(), sim._percent
         twin._apply_fold_targets()  # strip targets, passive flags, weights
         floor = np.full(sim.pattern.n_edges, np.nan)
