@@ -1,43 +1,42 @@
 """Origami Simulator's Miura folded flat: how far thickness lets it go (issue 17).
 
 The layout of Origami Simulator's ``Tessellations/miura-ori.svg`` (12 × 13
-facets, 182 vertices; its zig-zag lines run at about 84° to the straight
-ones): Miura 12 × 13, a = b = 80 mm, γ = GAMMA, every crease driven to its
-zero-thickness rigid-fold angle (:func:`foldcore.patterns.miura_fold_angles`)
-at facet tilt θ, default strategy unless the row names another, tolerance 1e-9. Folded at tilt 45° (every
-crease below 90°) and at tilt 90° (flat: zig-zag creases at 180°, straight
-ones at 180° too).
+facets, 182 vertices; its zig-zag lines run at about 84° to the straight ones):
+Miura 12 × 13, a = b = 80 mm, γ = GAMMA, every crease driven to its zero-
+thickness rigid-fold angle (:func:`foldcore.patterns.miura_fold_angles`) at
+facet tilt θ, default strategy unless the row names another, tolerance 1e-9.
+Folded at tilt 45° (every crease below 90°) and at tilt 90° (flat: zig-zag
+creases at 180°, straight ones at 180° too).
 
 Why the flat fold misses, and why the straight creases miss most: the flat
 state is a singular point of the Miura's kinematics. At tilt θ = 90° − d the
-zig-zag creases are 2d short of flat and the straight ones, from
-tan(ρ/2) = cos γ·tan θ, 2d / cos γ short: at γ = 84° every degree the
-zig-zag creases miss shows as 1 / cos γ = 9.6° on the straight ones (the
-``ratio`` column: 9.3–13). Origami Simulator's own sheet has zero thickness.
-Here, flat, every degree-4 vertex stacks its four panels in four layers, and
-the crease opposite its odd crease (M/V unlike the other three) must wrap
-around the other three. Equal hinges stack each pair of panels the same
-distance apart (an axis hinge pivots about its inner surface at 180°, panels
-H apart; an arc hinge of width W puts them 2W / π apart), so the loop around
-each vertex misses by two layers: the sheet has no flat state, and the run
-ends at the binding equilibrium (nearly scale-free: zig-zag misses 0.72° and
-0.79° at H / a = 0.01 and 0.001, Eq. 7's W / H). The fix this points to is checked on the last rows: arc hinges
-whose straight-crease widths grow by twice the zig-zag width per vertex along
-each line (:func:`foldcore.patterns.miura_flat_widths`: every wrapping crease
-as wide as the other three together) fold the same sheet exactly flat, and a
+zig-zag creases are 2d short of flat and the straight ones, from tan(ρ/2) = cos
+γ·tan θ, 2d / cos γ short: at γ = 84° every degree the zig-zag creases miss
+shows as 1 / cos γ = 9.6° on the straight ones (the ``ratio`` column: 9.3–13).
+Origami Simulator's own sheet has zero thickness. Here, flat, every degree-4
+vertex stacks its four panels in four layers, and the crease opposite its odd
+crease (M/V unlike the other three) must wrap around the other three. Equal
+hinges stack each pair of panels the same distance apart (an axis hinge pivots
+about its inner surface at 180°, panels H apart; an arc hinge of width W puts
+them 2W / π apart), so the loop around each vertex misses by two layers: the
+sheet has no flat state, and the run ends at the binding equilibrium (nearly
+scale-free: zig-zag misses 0.72° and 0.79° at H / a = 0.01 and 0.001, Eq. 7's W
+/ H). The fix this points to is checked on the last rows: arc hinges whose
+straight-crease widths grow by twice the zig-zag width per vertex along each
+line (:func:`foldcore.patterns.miura_flat_widths`: every wrapping crease as
+wide as the other three together) fold the same sheet exactly flat, and a
 single such vertex (``vertex`` rows: the wrapping crease 3W, or all W) shows
 the same at one vertex. The widths reach 23 W on a 12-facet line: a uniform
 thick Miura has no flat state, and the widths that give one grow with the
 sheet.
 
-Per row: θ* (degrees), iterations, verdict, wall time (median of RUNS warm
-runs after one warm-up, interleaved across rows), the largest miss on the
-straight and on the zig-zag creases (degrees), their ratio and the energy left. Run:
+Per row: θ* (degrees), iterations, verdict, wall time (median of RUNS warm runs
+after one warm-up, interleaved across rows), the largest miss on the straight
+and on the zig-zag creases (degrees), their ratio and the energy left. Run:
 ``.venv/bin/python bench/os_miura.py`` (a few minutes); writes
-bench/results/os_miura.json and .png (the flat fold's misses against the
-zig-zag miss / cos γ line, and each case's time) and prints the README table;
-``--plot`` redraws the PNG from the JSON.
-"""
+bench/results/os_miura.json and .png (the flat fold's misses against the zig-
+zag miss / cos γ line, and each case's time) and prints the README table;
+``--plot`` redraws the PNG from the JSON."""
 from __future__ import annotations
 
 import json

@@ -162,7 +162,6 @@ class RigidBodySolver:
         self._previous_velocity = None  # the last accepted plain step's velocity
         self.slow_ratio = 0.0  # the largest ratio an extrapolation used this run (0: none)
         self._accepted_move = None  # mm, the run's last accepted step, if the last step
-        self._last_lin = None  # the last step's linear model (distance_left)
         self._chains = None  # place_interiors' batches, built on first use
         self.distance = np.inf  # mm, estimated distance left after the last step
         self.energy_scale = 0.0
@@ -724,7 +723,6 @@ class RigidBodySolver:
             self._fitted = True
         start = self._state()
         lin = self._linearise(start)
-        self._last_lin = lin
         res, grad = lin.residual, lin.grad
         energy = float(res @ res)
         t0 = time.perf_counter()

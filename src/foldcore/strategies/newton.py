@@ -40,8 +40,9 @@ limit too — or, on a compatible fold, E down to tolerance² of the run's
 largest, where the steps are rounding.
 
 Cost per step: one assembly of H into a fixed pattern (:class:`HessianPattern`)
-and one sparse Cholesky per trial (CHOLMOD refactors in place, else SciPy), plus 1 + ``CORRECTIONS`` local steps and K
-solves per trial (the accepted trial's projections serve the next step). Units: mm.
+and one sparse Cholesky per trial (CHOLMOD refactors in place, else SciPy),
+plus 1 + ``CORRECTIONS`` local steps and K solves per trial (the accepted
+trial's projections serve the next step). Units: mm.
 """
 from __future__ import annotations
 
@@ -163,13 +164,13 @@ class Newton(Strategy):
         """Values of H = K ⊗ I₃ − Σ w Q Qᵀ at the projections ``targets`` (nnz, 3) mm, in
         the fixed pattern of :class:`HessianPattern` (built anew when K changes)."""
         sim = self.sim
+        bases = list(self._rotation_bases(targets))
         if self._pattern is None or self._pattern.version != sim.system.version:
-            blocks = [ids for ids, _, _ in self._rotation_bases(targets)]
-            self._pattern = HessianPattern(sim.system, blocks)
+            self._pattern = HessianPattern(sim.system, [ids for ids, _, _ in bases])
             self._factor = None
-        blocks = [-weights[:, None, None] * np.matmul(basis, basis.transpose(0, 2, 1))
-                  for _, weights, basis in self._rotation_bases(targets)]
-        return self._pattern.values(blocks)
+        return self._pattern.values([-weights[:, None, None]
+                                     * np.matmul(basis, basis.transpose(0, 2, 1))
+                                     for _, weights, basis in bases])
 
     def _solve(self, values: np.ndarray, rhs: np.ndarray) -> np.ndarray:
         """(H + λ D)⁻¹ rhs, D the diagonal of K ⊗ I₃; the factor keeps its symbolic
