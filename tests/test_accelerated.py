@@ -174,7 +174,8 @@ def test_hybrid_survives_an_interrupted_rigid_phase_and_keeps_given_positions():
     in its L-BFGS phase; positions set by the user are continued from, not refitted
     (a restart from a converged state moves < 1e-6 mm); a rigid phase that meets the
     run's tolerance ends the run, converged, also on the budget's last iteration;
-    at tolerance 0 L-BFGS takes over once the rigid steps stop moving."""
+    at tolerance 0 Gauss–Newton (``newton``) takes over once the rigid steps stop
+    moving, and new targets give the next run L-BFGS as its finish again."""
     pattern, mesh = hinge(20.0)
     sim = Simulation(mesh, pattern, solver="hybrid")
 
@@ -201,7 +202,9 @@ def test_hybrid_survives_an_interrupted_rigid_phase_and_keeps_given_positions():
                                                            max_iterations=rigid_steps)
     assert exact.iterations == rigid_steps and exact.converged
     phases = []
-    Simulation(mesh, pattern, solver="hybrid").run(  # tolerance 0: L-BFGS takes over
-        tolerance=0.0, max_iterations=rigid_steps + 40,
-        callback=lambda s, moved: phases.append(s.strategy.phase))
-    assert phases[0] == "rigid" and phases[-1] == "lbfgs"
+    handed = Simulation(mesh, pattern, solver="hybrid")
+    handed.run(tolerance=0.0, max_iterations=rigid_steps + 40,  # tolerance 0: newton takes over
+               callback=lambda s, moved: phases.append(s.strategy.phase))
+    assert phases[0] == "rigid" and phases[-1] == "newton"
+    handed.set_fold_percent(50.0)
+    assert handed.strategy.phase == "lbfgs"

@@ -1,4 +1,4 @@
-"""``hybrid``: rigid-body steps first, L-BFGS where they cannot finish (a composite).
+"""``hybrid``: rigid-body steps first, Gauss–Newton where they cannot finish (a composite).
 
 Each :meth:`Simulation.run` starts with a rigid phase (:mod:`.rigid`) from
 the current positions (one rigid-body engine serves every run: its column
@@ -8,9 +8,17 @@ lowering the energy by ≤ tolerance × E) ends the run there: the rigid-body
 model's equilibrium (panels exactly rigid, each passive crease one bounded
 bend). Otherwise the phase ends when an accepted step moves ≤
 ``HYBRID_RIGID_TOL`` × size (a run with a tighter tolerance, e.g. 0) or
-after ``HYBRID_RIGID_MAX`` steps, and :mod:`.lbfgs` continues
-from where it stopped on the paper's own energy (Eq. 9 passive sub-strips,
-panels as stiff elements). Why the run ends with the rigid phase when it
+after ``HYBRID_RIGID_MAX`` steps, and :mod:`.newton` continues from where
+it stopped on the paper's own energy (Eq. 9 passive sub-strips, panels as
+stiff elements; :mod:`.lbfgs` on meshes ``newton`` refuses, e.g. stretch
+hinges). Why ``newton`` and not L-BFGS there (measured 2026-12-03, 2-core
+Xeon guest, tolerance 1e-8/1e-9): a run hands over where the rigid model's
+state is not the paper model's equilibrium, mostly at a binding fold, where
+the residual left makes L-BFGS crawl — Origami Simulator's map fold,
+Miura and simple vertex at 90 % ran L-BFGS's 3 000-iteration budget
+(``bench/real_patterns.py``), the map fold 69.8° off; with ``newton`` they
+converge in 193, 213 and 154 iterations (map fold 19.2° off), a thick
+Miura 4 × 4 driven flat in 128 (L-BFGS: budget). Why the run ends with the rigid phase when it
 settles (measured, issue 16): where the rigid phase converges the L-BFGS
 phase only changes the state within the tolerance on compatible scenes, and
 under angle-controlled actuation its 10³ stiffness contrast kept it from
@@ -21,11 +29,13 @@ L-BFGS 10 000 without converging). A mesh the rigid phase cannot take
 there: that module's docstring), which from the rest state starts on the
 mesh's rigid-panel twin (:class:`_RigidStart`) — and so does a run
 with a fading position target (``decay`` < 1, counted in iterations: the
-rigid phase would settle on the pull before it fades). Bare :meth:`Simulation.step` calls outside a run are L-BFGS steps;
-whatever ends a rigid phase (its criterion, the budget, an exception or an
-interrupt), the strategy is left in its L-BFGS phase. Changed targets start
-the next run with a rigid phase again; positions set from outside are
-continued from with L-BFGS (a rigid phase would refit the panels).
+rigid phase would settle on the pull before it fades). Bare
+:meth:`Simulation.step` calls outside a run are steps of the finish (L-BFGS,
+or ``newton`` after a hand-over); a rigid phase ended otherwise than by its
+hand-over (its criterion, an exception or an interrupt) leaves the strategy
+in its L-BFGS phase. Changed targets start the next run with a rigid phase
+again (and L-BFGS as the finish until it hands over); positions set from
+outside are continued from with L-BFGS (a rigid phase would refit the panels).
 """
 from __future__ import annotations
 
@@ -97,13 +107,16 @@ class _RigidStart:
 
 
 class Hybrid(Strategy):
-    """``rigid`` for the first steps of each run, then ``lbfgs`` (``newton`` on rings)."""
+    """``rigid`` for the first steps of each run, then ``newton`` (``lbfgs`` where
+    ``newton`` refuses the mesh, and for positions set from outside)."""
 
     name = "hybrid"
 
     def __init__(self, sim):
         super().__init__(sim)
         self.finish = _finishing(sim)  # L-BFGS, or Newton on elastic cells
+        self._default_finish = self.finish
+        self._newton = None  # the finish after a rigid phase hands over (False: refused)
         self.rigid = None  # the rigid phase's strategy while it runs
         self._rigid_steps = 0
         self._pending = True  # the next run starts with a rigid phase
@@ -181,11 +194,32 @@ class Hybrid(Strategy):
             return False  # the twin's steps: it hands over itself when it stalls
         tiny = self.rigid.engine.accepted and moved <= HYBRID_RIGID_TOL * self.sim.length_scale
         if done or tiny or self._rigid_steps >= HYBRID_RIGID_MAX:
-            if not done:  # L-BFGS takes over: the run will not end at a rigid state
+            if not done:  # the run will not end at a rigid state: Newton takes over
                 self.rigid.hand_over()
                 self.rigid.engine.forget_ends()
+                self._finish_with_newton()
             self._leave_rigid_phase()
         return done
+
+    def _finish_with_newton(self) -> None:
+        """After a rigid phase that handed over unsettled, ``newton`` finishes (where
+        it takes the mesh; else the default finish): from the rigid state the paper
+        model's equilibrium is near, and its residual left (a binding fold) makes
+        L-BFGS crawl (module docstring)."""
+        if self._newton is None:
+            try:
+                self._newton = Newton(self.sim)
+            except SimulationError:
+                self._newton = False  # e.g. stretch hinges: the default finish
+        if self._newton:
+            self.finish = self._newton
+
+    def _default_finishing(self) -> None:
+        """New targets or positions from outside: the default finish again (L-BFGS
+        on a rigid-panel mesh; positions set are continued from with it)."""
+        if self.finish is not self._default_finish:
+            self.finish = self._default_finish
+            self.finish.restart()
 
     def predict(self, ratio: float) -> bool:
         if not self._engine or not self._engine.predict(ratio):
@@ -208,12 +242,14 @@ class Hybrid(Strategy):
         self.finish.restart()
 
     def targets_changed(self) -> None:
+        self._default_finishing()
         self.finish.restart()
         self._pending = True
 
     def positions_set(self) -> None:
         self._start = None
         self._leave_rigid_phase()
+        self._default_finishing()
         if self._engine:
             self._engine.engine.forget_ends()
         self._pending = False
