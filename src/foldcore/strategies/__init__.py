@@ -13,8 +13,9 @@ one strategy, which only moves the state. Built in:
   acceleration (:mod:`.rigid`, engine in :mod:`foldcore.rigid_body`).
 * ``hybrid`` — a composite: each run starts with ``rigid`` steps, ends
   there once they meet the tolerance, else continues with ``newton``
-  (``lbfgs`` on meshes it refuses) from where they stop; a mesh whose elastic faces are all cut into rings starts
-  on its rigid-panel twin and finishes with ``newton``; other meshes
+  (``lbfgs`` on meshes it refuses) from where they stop; a mesh whose
+  elastic faces are all cut into rings starts on its rigid-panel twin and
+  finishes with ``newton``; other meshes
   ``rigid`` cannot take (bars, plates, other element types) run ``lbfgs``
   (:mod:`.hybrid`).
 * ``newton`` — Gauss–Newton / Levenberg–Marquardt on every vertex, each

@@ -1,4 +1,4 @@
-"""``hybrid``: rigid-body steps first, Gauss–Newton where they cannot finish (a composite).
+"""``hybrid``: rigid-body steps first, Gauss–Newton where they cannot finish.
 
 Each :meth:`Simulation.run` starts with a rigid phase (:mod:`.rigid`) from
 the current positions (one rigid-body engine serves every run: its column
@@ -18,8 +18,8 @@ the residual left makes L-BFGS crawl — Origami Simulator's map fold,
 Miura and simple vertex at 90 % ran L-BFGS's 3 000-iteration budget
 (``bench/real_patterns.py``), the map fold 69.8° off; with ``newton`` they
 converge in 193, 213 and 154 iterations (map fold 19.2° off), a thick
-Miura 4 × 4 driven flat in 128 (L-BFGS: budget). Why the run ends with the rigid phase when it
-settles (measured, issue 16): where the rigid phase converges the L-BFGS
+Miura 4 × 4 driven flat in 128 (L-BFGS: budget). Why the run ends with the
+rigid phase when it settles (measured, issue 16): where the rigid phase converges the L-BFGS
 phase only changes the state within the tolerance on compatible scenes, and
 under angle-controlled actuation its 10³ stiffness contrast kept it from
 converging at all (Pehrson's vertex folded flat: rigid 21 iterations, then

@@ -237,10 +237,14 @@ class HessianPattern:
             rows.append(np.repeat(dof, 3 * m, axis=1).ravel())
             cols.append(np.tile(dof, (1, 3 * m)).ravel())
         rows, cols = np.concatenate(rows), np.concatenate(cols)
-        self.lower = rows >= cols  # the entries CHOLMOD reads
+        lower = rows >= cols  # the entries CHOLMOD reads
         size = base.shape[0]
-        keys, self.slot = np.unique(cols[self.lower].astype(np.int64) * size
-                                    + rows[self.lower], return_inverse=True)
+        keys, slot = np.unique(cols[lower].astype(np.int64) * size + rows[lower],
+                               return_inverse=True)
+        #: slot in the CSC data of every entry, in :meth:`values`' order; the upper
+        #: triangle's go to one extra slot that is dropped (no masked copy per step)
+        self.slot = np.full(len(rows), len(keys), dtype=np.int64)
+        self.slot[lower] = slot
         self.indices = (keys % size).astype(np.int32)
         self.indptr = np.searchsorted(keys // size, np.arange(size + 1)).astype(np.int32)
         self.shape = (size, size)
@@ -254,7 +258,8 @@ class HessianPattern:
     def values(self, blocks) -> np.ndarray:
         """(nnz,) values of H from each run's (n, 3m, 3m) blocks (order of ``blocks``)."""
         entries = np.concatenate([self.base_values] + [b.ravel() for b in blocks])
-        return np.bincount(self.slot, weights=entries[self.lower], minlength=len(self.indices))
+        nnz = len(self.indices)
+        return np.bincount(self.slot, weights=entries, minlength=nnz + 1)[:nnz]
 
     def matrix(self, values: np.ndarray, damping: float):
         """Lower triangle of H + ``damping`` × D (D the diagonal of K ⊗ I₃), CSC."""
