@@ -227,20 +227,23 @@ def test_a_converged_binding_fold_is_within_the_tolerance_of_its_equilibrium():
     vertex cannot close, tests/test_flat_fold.py) has a residual left, where a
     Gauss–Newton step makes the last step's Jacobian blind to what is left
     (J₀ᵀ r(x₀ + v) ≈ 0): the simplified correction measured with it stopped the
-    run after 92 iterations 2.2e-3 mm from the equilibrium, 18 000 × the limit.
+    run after 92 iterations 2.2e-3 mm from the equilibrium, 18 000 × the limit;
+    and E's rounding noise hides the last steps' decrease (rejected steps
+    stopped a run 8 × the limit away, RigidBodySolver._closer_within_rounding).
     Converged at tolerance 1e-9, the positions must be within the distance two
-    runs each within tolerance × size of the equilibrium can be apart (2 × the
-    limit; measured 2.3 ×, so 3 ×) of the run at 1e-13."""
+    runs each within tolerance × size of the equilibrium can be apart (1.01 ×
+    the limit; 2 × allowed for the estimate) of the run at 1e-11 (the tightest
+    this fold resolves: below it the steps stop shrinking at ~5e-11 mm)."""
     n, gamma = 6, 84.0
     angles = patterns.miura_fold_angles(n, n, gamma, 90.0)
     pattern = patterns.miura(n, n, a=A, b=A, gamma=gamma).replace(fold_angles=angles)
     mesh = thicken(pattern, 0.01 * A)
     loose = Simulation(mesh, pattern).run(tolerance=1e-9, max_iterations=3000)
     sim = Simulation(mesh, pattern)
-    tight = sim.run(tolerance=1e-13, max_iterations=3000)
+    tight = sim.run(tolerance=1e-11, max_iterations=3000)
     assert loose.converged and tight.converged
     limit = 1e-9 * sim.length_scale
-    assert np.abs(loose.positions - tight.positions).max() <= 3 * limit
+    assert np.abs(loose.positions - tight.positions).max() <= 2 * limit
 
 
 def test_extrapolating_a_binding_tail_keeps_the_equilibrium(monkeypatch):

@@ -44,7 +44,11 @@ from .measure import best_rotations
 
 SEED = 1e-2          # rad: pre-bend of a passive M/V strip that starts flat
 LAMBDA_START = 1e-4  # initial Levenberg–Marquardt damping (relative to diag of JᵀJ)
-LAMBDA_MIN, LAMBDA_MAX = 1e-12, 1e12
+LAMBDA_MIN = float(np.finfo(float).eps)  # smallest damping that still changes JᵀJ + λD
+#   in floating point. A larger floor damps the sheet's softest mode: at 1e-12 a thin
+#   Miura 50 × 50 ended in a linear tail, × 0.742 per step for 45 steps at ρ = 1
+#   (λD ≈ 3 × its softest eigenvalue); 124 → 81 iterations.
+LAMBDA_MAX = 1e12
 LAMBDA_SETTLED = 1.0  # largest damping of an accepted step that may end a run
 DAMPED_SHARE_MAX = 0.1  # largest share of the damping in an accepted step's predicted
 #                         decrease that may end a run (RigidBodySolver.settled)
@@ -156,6 +160,7 @@ class RigidBodySolver:
         self._init_strips(sim._hinges)
         self._init_mv_sides(mesh, sim.pattern)
         self.lam = LAMBDA_START
+        self.jumped = self.follows_jump = False  # the last / the step before: extrapolated
         self.accepted, self.energy, self.decrease = False, np.inf, np.inf  # the last step's
         self.gain_ratio, self.damped_share = np.nan, 0.0  # the last step's (step)
         self.contraction = np.nan  # its length over the last accepted one's, this run
@@ -183,6 +188,7 @@ class RigidBodySolver:
             owner[ids] = p
         self.owner = owner
         self.on_panel = np.flatnonzero(owner >= 0)
+        self.panel_of = owner[self.on_panel]  # (N,) the panel of each panel vertex
         self.free = np.flatnonzero(owner < 0)
         rest = self.sim.mesh.rest_positions
         centroid = np.zeros((len(panels), 3))
@@ -507,8 +513,7 @@ class RigidBodySolver:
     # -------------------------------------------------------------- geometry
     def _positions(self, rot_p, c_p, y) -> np.ndarray:
         x = np.empty((self.sim.mesh.n_vertices, 3))
-        p = self.owner[self.on_panel]
-        x[self.on_panel] = np.einsum("nij,nj->ni", rot_p[p], self.body) + c_p[p]
+        rigid_normal.place_on_panels(rot_p, c_p, self.on_panel, self.panel_of, self.body, x)
         x[self.free] = y
         return x
 
@@ -744,19 +749,25 @@ class RigidBodySolver:
         moved = float(np.abs(trial.x - self.x).max())
         new_energy = self._trial_energy(trial)
         self.accepted, self.step_lam = new_energy <= energy, self.lam
+        unresolved = not self.accepted and self._closer_within_rounding(
+            trial, energy, new_energy, -float(grad @ velocity), factor)
+        self.accepted |= unresolved
         model = float(j_velocity @ j_velocity)  # ‖Jv‖²
         predicted = -2.0 * float(grad @ velocity) - model  # = ‖Jv‖² + 2λ vᵀDv
-        if predicted > 0:
+        if unresolved:  # E cannot judge the model there: λ stays
+            self.gain_ratio, self.damped_share = np.nan, 1.0 - model / max(predicted, 1e-300)
+        elif predicted > 0:
             self.gain_ratio = (energy - new_energy) / predicted
             self.damped_share = 1.0 - model / predicted
         else:  # ≤ 0 only by rounding: no verdict on the model
             self.gain_ratio, self.damped_share = np.nan, 0.0
         jumped = False
-        if self.accepted:
+        if self.accepted and not unresolved:
             trial, new_energy, jumped = self._extrapolated(start, velocity, trial, new_energy)
             if jumped:
                 moved = float(np.abs(trial.x - self.x).max())
         self._previous_velocity = velocity if self.accepted and not jumped else None
+        self.follows_jump, self.jumped = self.jumped, jumped
         if self.accepted:
             self._set_state(trial)
             last = self._accepted_move
@@ -772,6 +783,31 @@ class RigidBodySolver:
         self.energy = energy
         self.energy_scale = max(self.energy_scale, energy)
         return energy, moved
+
+    def _closer_within_rounding(self, trial: State, energy: float, new_energy: float,
+                                decrement: float, factor: Factor) -> bool:
+        """Whether a trial whose energy rose by no more than rounding (``ROUNDING`` × E,
+        mm⁵) still came closer to the equilibrium: its Newton decrement g̃ᵀ(JᵀJ + λD)⁻¹g̃
+        (g̃ = Jᵀr at the trial; one solve with the step's factorisation) is below the
+        start's ``decrement`` (mm⁵). The shapes must be the trial's.
+
+        Why: at a binding equilibrium the energy E left is far above zero, and E's
+        rounding noise (positions ~100 mm against residuals of a few µm) hides
+        the last steps' decrease: a thick Miura 6 × 6 driven flat (E = 0.071 mm⁵)
+        rejected 14 Gauss–Newton steps in a row at ρ ≈ −10 and stopped 2.5e-7 mm
+        from where the gradient still pointed, 8 × the limit of tolerance 1e-9
+        from the equilibrium a run at 1e-13 reaches. The gradient still resolves
+        what E no longer does."""
+        if not new_energy - energy <= ROUNDING * energy:
+            return False
+        residual = self._residuals_at_shapes(trial)
+        here = Linearisation(self, trial, residual, self._strip_targets,
+                             self._angle_columns(trial.rot_e), self._extra_rows(trial))
+        g = here.apply_transpose(residual)
+        t0 = time.perf_counter()
+        trial_decrement = float(g @ factor.solve(g))
+        self.solve_time += time.perf_counter() - t0
+        return trial_decrement < decrement
 
     def _extrapolated(self, start: State, velocity, trial: State, energy: float):
         """(state, energy, whether extrapolated): the accepted ``trial`` (at ``energy``),
@@ -1032,6 +1068,25 @@ class RigidBodySolver:
                     or self.step_lam >= LAMBDA_MAX
                     or (quiet and -self.decrease <= tolerance * self.energy + floor))
 
+    def stalls(self, moved: float, relative: float) -> bool:
+        """Whether the last step, of largest vertex move ``moved`` mm ≤ ``relative`` ×
+        the pattern's size, was rejected with its energy within rounding
+        (``ROUNDING`` × E) of the start's or at the rounding floor, or was accepted and did not contract (Θ ≥ 1, or unknown
+        but after an extrapolation; a move of rounding size, ``ROUNDING`` × the
+        size, always stalls): where the steps still shrink steadily the run
+        is converging, however small they are (a thick Miura 6 × 6 driven flat at
+        tolerance 1e-13: steps of 1e-8 mm contracting by 0.85, handed over to
+        ``newton``, which wandered at that size to the budget)."""
+        size = self.sim.length_scale
+        if moved > relative * size:
+            return False
+        if not self.accepted:  # neither lower nor closer (_closer_within_rounding)
+            return bool(-self.decrease <= ROUNDING * self.energy
+                        or self.energy <= self._rounding_energy())
+        contracting = moved > ROUNDING * size and (self.contraction < 1.0 or self.jumped
+                                                   or self.follows_jump)
+        return not contracting
+
     def distance_left(self, moved: float, limit: float, energy_limit=None) -> float:
         """Estimated distance (mm) from the state after the last step (of largest
         vertex move ``moved`` mm) to the equilibrium, for a run whose limit is
@@ -1147,7 +1202,8 @@ class RigidBodySolver:
         if len(self.free):
             y += delta[self.free_col[0]:self.rot_col].reshape(-1, 3)
         s = len(self.ids)
-        rot_e = exp_so3(delta[self.rot_col:self.phi_col].reshape(s, 3)) @ state.rot_e
+        rot_e = np.empty_like(state.rot_e)
+        rigid_normal.rotate_by(delta[self.rot_col:self.phi_col].reshape(s, 3), state.rot_e, rot_e)
         phi = state.phi.copy()
         self._set_folds(np.clip(self._folds(phi) + delta[self.phi_col:], self.lo, self.hi), phi)
         return State(self._positions(rot_p, c_p, y), rot_p, c_p, y, rot_e, phi)
@@ -1168,17 +1224,10 @@ class RigidBodySolver:
         motion matches the linear prediction in the least-squares sense at
         the panel's hinge-strip vertices (the joints), not at its centroid.
         """
-        rot = exp_so3(w[:, :3])
-        p = self.owner[self.on_panel]
-        a = np.einsum("nij,nj->ni", state.rot_p[p], self.body)
-        linear = a + np.cross(w[p, :3], a) + w[p, 3:]
-        shift = linear - np.einsum("nij,nj->ni", rot[p], a)
-        c_p = state.c_p.copy()
-        total = np.bincount(p, weights=self.joint_weight, minlength=len(c_p))
-        for d in range(3):
-            c_p[:, d] += np.bincount(p, weights=self.joint_weight * shift[:, d],
-                                     minlength=len(c_p)) / np.maximum(total, 1e-300)
-        return rot @ state.rot_p, c_p
+        rot_p, c_p = np.empty_like(state.rot_p), np.empty_like(state.c_p)
+        rigid_normal.move_panels(state.rot_p, state.c_p, w, self.panel_of, self.body,
+                                 self.joint_weight, rot_p, c_p)
+        return rot_p, c_p
 
     def _trial_energy(self, state: State) -> float:
         """Energy of a trial state after refitting its strips' rotations (Procrustes)."""

@@ -466,3 +466,72 @@ def carry_free(slot, panel, weight, y, c_old, rot_old, rot_new, c_new, out):
         for d in range(3):
             out[v, d] += w * (rot_new[p, d, 0] * b0 + rot_new[p, d, 1] * b1
                               + rot_new[p, d, 2] * b2 + c_new[p, d])
+
+
+@njit(cache=True, inline="always")
+def _rodrigues(w0, w1, w2):
+    """exp([w]×) of one rotation vector (rad), as its 9 entries row by row."""
+    angle = np.sqrt(w0 * w0 + w1 * w1 + w2 * w2)
+    if angle < 1e-8:
+        a, b = 1.0 - angle ** 2 / 6.0, 0.5 - angle ** 2 / 24.0
+    else:
+        a, b = np.sin(angle) / angle, (1.0 - np.cos(angle)) / angle ** 2
+    # I + a K + b K², K = [w]×, K² = w wᵀ − |w|² I
+    s = w0 * w0 + w1 * w1 + w2 * w2
+    return (1.0 + b * (w0 * w0 - s), -a * w2 + b * w0 * w1, a * w1 + b * w0 * w2,
+            a * w2 + b * w1 * w0, 1.0 + b * (w1 * w1 - s), -a * w0 + b * w1 * w2,
+            -a * w1 + b * w2 * w0, a * w0 + b * w2 * w1, 1.0 + b * (w2 * w2 - s))
+
+
+@njit(cache=True)
+def rotate_by(w, rot, out):
+    """out[i] = exp([w_i]×) rot[i] for (n, 3) rotation vectors (rad) and (n, 3, 3) rotations."""
+    for i in range(w.shape[0]):
+        e = _rodrigues(w[i, 0], w[i, 1], w[i, 2])
+        for r in range(3):
+            for c in range(3):
+                out[i, r, c] = (e[3 * r] * rot[i, 0, c] + e[3 * r + 1] * rot[i, 1, c]
+                                + e[3 * r + 2] * rot[i, 2, c])
+
+
+@njit(cache=True)
+def move_panels(rot_p, c_p, w, panel, body, weight, rot_out, c_out):
+    """Panels moved by increments ``w`` (P, 6: rotation vector, rad, and shift, mm).
+
+    Rotations: rot_out = exp([ω]×) rot_p. Centres: c_out = c_p + the weighted
+    mean over each panel's joint vertices (``panel`` (N,) their panel, ``body``
+    (N, 3) their body-frame offsets, ``weight`` (N,)) of the shift that makes the
+    rigid motion meet the linear prediction a + ω × a + t there (a = rot_p · body).
+    """
+    rotate_by(w[:, :3], rot_p, rot_out)
+    c_out[:, :] = 0.0
+    total = np.zeros(c_p.shape[0])
+    for n in range(panel.shape[0]):
+        p = panel[n]
+        a0 = rot_p[p, 0, 0] * body[n, 0] + rot_p[p, 0, 1] * body[n, 1] + rot_p[p, 0, 2] * body[n, 2]
+        a1 = rot_p[p, 1, 0] * body[n, 0] + rot_p[p, 1, 1] * body[n, 1] + rot_p[p, 1, 2] * body[n, 2]
+        a2 = rot_p[p, 2, 0] * body[n, 0] + rot_p[p, 2, 1] * body[n, 1] + rot_p[p, 2, 2] * body[n, 2]
+        o0, o1, o2 = w[p, 0], w[p, 1], w[p, 2]
+        lin0 = a0 + o1 * a2 - o2 * a1 + w[p, 3]
+        lin1 = a1 + o2 * a0 - o0 * a2 + w[p, 4]
+        lin2 = a2 + o0 * a1 - o1 * a0 + w[p, 5]
+        e = _rodrigues(o0, o1, o2)
+        wt = weight[n]
+        c_out[p, 0] += wt * (lin0 - (e[0] * a0 + e[1] * a1 + e[2] * a2))
+        c_out[p, 1] += wt * (lin1 - (e[3] * a0 + e[4] * a1 + e[5] * a2))
+        c_out[p, 2] += wt * (lin2 - (e[6] * a0 + e[7] * a1 + e[8] * a2))
+        total[p] += wt
+    for p in range(c_p.shape[0]):
+        scale = 1.0 / max(total[p], 1e-300)
+        for d in range(3):
+            c_out[p, d] = c_p[p, d] + c_out[p, d] * scale
+
+
+@njit(cache=True)
+def place_on_panels(rot_p, c_p, vertex, panel, body, x):
+    """x[vertex[n]] = rot_p[panel[n]] · body[n] + c_p[panel[n]] (mm)."""
+    for n in range(vertex.shape[0]):
+        v, p = vertex[n], panel[n]
+        for d in range(3):
+            x[v, d] = (rot_p[p, d, 0] * body[n, 0] + rot_p[p, d, 1] * body[n, 1]
+                       + rot_p[p, d, 2] * body[n, 2] + c_p[p, d])

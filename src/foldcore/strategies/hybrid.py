@@ -192,7 +192,7 @@ class Hybrid(Strategy):
         done = self.rigid.settled(moved, limit)
         if coarse and not done and self._rigid_steps < HYBRID_RIGID_MAX:
             return False  # the twin's steps: it hands over itself when it stalls
-        tiny = self.rigid.engine.accepted and moved <= HYBRID_RIGID_TOL * self.sim.length_scale
+        tiny = self.rigid.engine.stalls(moved, HYBRID_RIGID_TOL)
         if done or tiny or self._rigid_steps >= HYBRID_RIGID_MAX:
             if not done:  # the run will not end at a rigid state: Newton takes over
                 self.rigid.hand_over()

@@ -141,8 +141,7 @@ class Rigid(Strategy):
         done = self._engine_call(engine.settled, moved, limit / self.sim.length_scale)
         self.sim.equilibrium.residual = engine.distance / self.sim.length_scale
         if self.twin is not None:
-            stalls = engine.accepted and moved <= TWIN_STALL * self.sim.length_scale
-            if (done or stalls) and self.sim.stage != "branch":
+            if (done or engine.stalls(moved, TWIN_STALL)) and self.sim.stage != "branch":
                 self.hand_over()
                 return False
             self._branch_done = done
