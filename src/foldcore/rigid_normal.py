@@ -36,6 +36,7 @@ block). Units: mm, rad.
 """
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import numba
@@ -471,11 +472,11 @@ def carry_free(slot, panel, weight, y, c_old, rot_old, rot_new, c_new, out):
 @njit(cache=True, inline="always")
 def _rodrigues(w0, w1, w2):
     """exp([w]×) of one rotation vector (rad), as its 9 entries row by row."""
-    angle = np.sqrt(w0 * w0 + w1 * w1 + w2 * w2)
+    angle = math.sqrt(w0 * w0 + w1 * w1 + w2 * w2)
     if angle < 1e-8:
         a, b = 1.0 - angle ** 2 / 6.0, 0.5 - angle ** 2 / 24.0
     else:
-        a, b = np.sin(angle) / angle, (1.0 - np.cos(angle)) / angle ** 2
+        a, b = math.sin(angle) / angle, (1.0 - math.cos(angle)) / angle ** 2
     # I + a K + b K², K = [w]×, K² = w wᵀ − |w|² I
     s = w0 * w0 + w1 * w1 + w2 * w2
     return (1.0 + b * (w0 * w0 - s), -a * w2 + b * w0 * w1, a * w1 + b * w0 * w2,
