@@ -175,6 +175,8 @@ class RigidBodySolver:
         self._ends = []  # the states two earlier runs ended in (a path's predictor)
         self._fitted = False
         self.solve_time = 0.0  # s spent factorising and solving (the rest is assembly)
+        self._normal_factor = None  # of JᵀJ + λD, from the first step on a layout
+        self._columns_ready = False  # the unknowns' columns (_columns)
         self.x = self._positions(self.rot_p, self.c_p, self.y)
 
     # ------------------------------------------------------------------ setup
@@ -386,29 +388,42 @@ class RigidBodySolver:
         return sp.csr_matrix((vals.ravel(), (rows.ravel(), cols.ravel())), shape=(24 * s, 3 * n))
 
     def _layout(self, passive: np.ndarray) -> None:
-        """Column blocks of the unknowns: panels, free vertices, strip rotations, angles."""
-        sim = self.sim
+        """The passive creases' angle unknowns; the column blocks of the unknowns
+        (:meth:`_columns`) follow at the next linearisation.
+
+        Why not the columns at once: a coarse twin hands its state to the mesh's
+        engine (:meth:`adopt` reads the targets), after which the run may end
+        without a step of it (:meth:`strips_placed_within`); the layout and the
+        normal-matrix pattern of a thin Miura 50 × 50 (255 093 unknowns) were
+        the run's peak memory there (RSS 386 → 490 MB)."""
+        self.passive_ids = np.flatnonzero(passive)
+        src = self.hinges.group.source[self.passive_ids]
+        _, self.passive_of = np.unique(src, return_inverse=True)
+        self.n_folds = int(self.passive_of.max()) + 1 if len(src) else 0
+        self._passive = passive.copy()
+        self._pinned = bool(self.sim._position_targets)
+        self._columns_ready = False
+
+    def _columns(self) -> None:
+        """Column blocks of the unknowns: panels, free vertices, strip rotations, angles;
+        the Jacobian maps and the normal matrix's pattern. Built once per layout."""
+        if self._columns_ready:
+            return
         n_panels = len(self.rot_p)
         fixed = -1
-        if not sim._position_targets:  # no pins: one panel holds the rigid motion
+        if not self.sim._position_targets:  # no pins: one panel holds the rigid motion
             fixed = int(self.owner[0]) if self.owner[0] >= 0 else 0
         self.panel_col = np.full(n_panels, -1, dtype=np.int64)
         moving = np.flatnonzero(np.arange(n_panels) != fixed)
         self.panel_col[moving] = 6 * np.arange(len(moving))
         self.free_col = 6 * len(moving) + 3 * np.arange(len(self.free))
         self.rot_col = self.free_col[-1] + 3 if len(self.free) else 6 * len(moving)
-        s = len(self.ids)
-        self.passive_ids = np.flatnonzero(passive)
-        src = self.hinges.group.source[self.passive_ids]
-        _, self.passive_of = np.unique(src, return_inverse=True)
-        self.n_folds = int(self.passive_of.max()) + 1 if len(src) else 0
-        self.phi_col = self.rot_col + 3 * s
+        self.phi_col = self.rot_col + 3 * len(self.ids)
         self.n_unknowns = self.phi_col + self.n_folds
-        self._passive = passive.copy()
-        self._pinned = bool(sim._position_targets)
         self._map_pattern()
         self._strip_layout()
         self._normal_pattern()
+        self._columns_ready = True
 
     def _strip_layout(self) -> None:
         """Local columns of each strip for :mod:`foldcore.rigid_normal`: its crease's
@@ -652,6 +667,7 @@ class RigidBodySolver:
     def _linearise(self, state: State) -> "Linearisation":
         """JᵀJ (values on the fixed pattern), Jᵀr and r at a state, without forming J for
         the strips (:mod:`foldcore.rigid_normal`)."""
+        self._columns()
         residual = self._residuals(state)
         s = len(self.ids)
         lin = Linearisation(self, state, residual, self._strip_targets,
@@ -676,6 +692,7 @@ class RigidBodySolver:
     def _jacobian(self, state: State):
         """Sparse J (rows: strip residuals, pins, M/V rows) and r: the reference the
         assembled normal equations are tested against (not used by the step)."""
+        self._columns()
         residual = self._residuals(state)
         rot_e = state.rot_e
         targets = self._targets(rot_e)
@@ -720,6 +737,7 @@ class RigidBodySolver:
         """
         self._sync_weights()
         self._read_targets()
+        self._columns()
         self._update_shapes(self.phi)
         if not self._fitted:  # strips' rotations start at their exact fit
             self.rot_e = np.empty((len(self.ids), 3, 3))
@@ -975,6 +993,20 @@ class RigidBodySolver:
         self._previous_velocity, self.slow_ratio = None, 0.0
         self.energy_scale = max(self.energy_scale, float(energy_scale))
         self.lam = min(float(lam), LAMBDA_START)
+
+    def strips_placed_within(self, limit: float) -> bool:
+        """Whether every strip vertex lies within ``limit`` mm of its strip's bent shape
+        (strip rotations fitted; the strips' rows of the residual over √w): the
+        state is then an equilibrium of this model to that distance in every
+        strip — for a state another model handed over (:meth:`adopt`), where that
+        model's verdict holds for this one. Leaves the strip rotations fitted."""
+        self._update_shapes(self.phi)
+        rigid_normal.fit_strip_rotations(self.ids, self.x, self.shape.reshape(-1, 8, 3),
+                                         self.rot_e)
+        self._fitted = True
+        residual = self._residual(self.x, self.rot_e)
+        scale = np.where(self.sqrt_w > 0, self.sqrt_w, 1.0)
+        return bool(np.abs(residual / scale[:, None, None]).max(initial=0.0) <= limit)
 
     def place_interiors(self) -> np.ndarray:
         """(n_free, 3) mm: hinge-interior vertices where the strips' bent shapes put
