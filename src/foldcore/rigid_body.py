@@ -47,7 +47,7 @@ LAMBDA_START = 1e-4  # initial Levenberg–Marquardt damping (relative to diag o
 LAMBDA_MIN = float(np.finfo(float).eps)  # smallest damping that still changes JᵀJ + λD
 #   in floating point. A larger floor damps the sheet's softest mode: at 1e-12 a thin
 #   Miura 50 × 50 ended in a linear tail, × 0.742 per step for 45 steps at ρ = 1
-#   (λD ≈ 3 × its softest eigenvalue); 124 → 81 iterations.
+#   (λD ≈ 3 × its softest eigenvalue); 124 → 83 iterations.
 LAMBDA_MAX = 1e12
 LAMBDA_SETTLED = 1.0  # largest damping of an accepted step that may end a run
 DAMPED_SHARE_MAX = 0.1  # largest share of the damping in an accepted step's predicted
@@ -1103,12 +1103,13 @@ class RigidBodySolver:
     def stalls(self, moved: float, relative: float) -> bool:
         """Whether the last step, of largest vertex move ``moved`` mm ≤ ``relative`` ×
         the pattern's size, was rejected with its energy within rounding
-        (``ROUNDING`` × E) of the start's or at the rounding floor, or was accepted and did not contract (Θ ≥ 1, or unknown
-        but after an extrapolation; a move of rounding size, ``ROUNDING`` × the
-        size, always stalls): where the steps still shrink steadily the run
-        is converging, however small they are (a thick Miura 6 × 6 driven flat at
-        tolerance 1e-13: steps of 1e-8 mm contracting by 0.85, handed over to
-        ``newton``, which wandered at that size to the budget)."""
+        (``ROUNDING`` × E) of the start's or at the rounding floor, or was
+        accepted and did not contract (Θ ≥ 1, or unknown but not after an
+        extrapolation; a move of rounding size, ``ROUNDING`` × the size, always
+        stalls). Where the steps still shrink steadily the run is converging,
+        however small they are: a thick Miura 6 × 6 driven flat at tolerance
+        1e-13 took steps of 1e-8 mm contracting by 0.85 and was handed over to
+        ``newton``, which wandered at that size to the budget."""
         size = self.sim.length_scale
         if moved > relative * size:
             return False
