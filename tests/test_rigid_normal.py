@@ -61,3 +61,40 @@ def test_mv_side_rows_acting_match():
     rows, _ = engine._mv_terms(engine.rot_p)
     assert np.count_nonzero(rows) == 2
     compare(engine)
+
+
+def test_the_panel_motion_kernels_match_their_definitions():
+    """rotate_by is exp([w]×)·R (Rodrigues, small angles by series); move_panels keeps
+    each panel's joints where the linear step puts them, in the weighted least-squares
+    sense: the joints' weighted mean of (rigid − linear) motion is zero; to rounding."""
+    from foldcore import rigid_normal
+    from foldcore.rigid_body import exp_so3, skew
+
+    rng = np.random.default_rng(7)
+    n_panels, n_joints = 6, 40
+    rot = exp_so3(rng.standard_normal((n_panels, 3)))
+    w = np.column_stack([0.3 * rng.standard_normal((n_panels, 3)),
+                         rng.standard_normal((n_panels, 3))])
+    w[0, :3] = 1e-10  # the series branch
+    out = np.empty_like(rot)
+    rigid_normal.rotate_by(w[:, :3], rot, out)
+    np.testing.assert_allclose(out, exp_so3(w[:, :3]) @ rot, rtol=0, atol=1e-14)
+    np.testing.assert_allclose(exp_so3(np.array([[0.0, 0.0, np.pi / 2]]))[0] @ [1.0, 0, 0],
+                               [0.0, 1.0, 0.0], atol=1e-15)
+    panel = rng.integers(0, n_panels - 1, n_joints)  # the last panel has no joints
+    body = 10.0 * rng.standard_normal((n_joints, 3))
+    weight = rng.uniform(0.5, 2.0, n_joints)
+    centre = rng.standard_normal((n_panels, 3))
+    rot_new, c_new = np.empty_like(rot), np.empty_like(centre)
+    rigid_normal.move_panels(rot, centre, w, panel, body, weight, rot_new, c_new)
+    a = np.einsum("nij,nj->ni", rot[panel], body)
+    linear = centre[panel] + a + np.einsum("nij,nj->ni", skew(w[panel, :3]), a) + w[panel, 3:]
+    rigid = c_new[panel] + np.einsum("nij,nj->ni", rot_new[panel] @ rot[panel].transpose(0, 2, 1),
+                                     a)
+    gap = np.zeros((n_panels, 3))
+    np.add.at(gap, panel, weight[:, None] * (rigid - linear))
+    assert np.abs(gap[:-1]).max() < 1e-12 * np.abs(linear).max() * n_joints
+    np.testing.assert_array_equal(c_new[-1], centre[-1])  # no joints: the centre stays
+    x = np.zeros((n_joints + 2, 3))
+    rigid_normal.place_on_panels(rot, centre, np.arange(n_joints), panel, body, x)
+    np.testing.assert_allclose(x[:n_joints], a + centre[panel], rtol=0, atol=1e-13)

@@ -509,9 +509,10 @@ def move_panels(rot_p, c_p, w, panel, body, weight, rot_out, c_out):
     total = np.zeros(c_p.shape[0])
     for n in range(panel.shape[0]):
         p = panel[n]
-        a0 = rot_p[p, 0, 0] * body[n, 0] + rot_p[p, 0, 1] * body[n, 1] + rot_p[p, 0, 2] * body[n, 2]
-        a1 = rot_p[p, 1, 0] * body[n, 0] + rot_p[p, 1, 1] * body[n, 1] + rot_p[p, 1, 2] * body[n, 2]
-        a2 = rot_p[p, 2, 0] * body[n, 0] + rot_p[p, 2, 1] * body[n, 1] + rot_p[p, 2, 2] * body[n, 2]
+        b0, b1, b2 = body[n, 0], body[n, 1], body[n, 2]
+        a0 = rot_p[p, 0, 0] * b0 + rot_p[p, 0, 1] * b1 + rot_p[p, 0, 2] * b2
+        a1 = rot_p[p, 1, 0] * b0 + rot_p[p, 1, 1] * b1 + rot_p[p, 1, 2] * b2
+        a2 = rot_p[p, 2, 0] * b0 + rot_p[p, 2, 1] * b1 + rot_p[p, 2, 2] * b2
         o0, o1, o2 = w[p, 0], w[p, 1], w[p, 2]
         lin0 = a0 + o1 * a2 - o2 * a1 + w[p, 3]
         lin1 = a1 + o2 * a0 - o0 * a2 + w[p, 4]
