@@ -802,6 +802,13 @@ class RigidBodySolver:
         self.energy_scale = max(self.energy_scale, energy)
         return energy, moved
 
+    def _gradient(self, state: State, residual: np.ndarray) -> np.ndarray:
+        """Jᵀr (n_unknowns,) at ``state`` for its ``residual`` r, just computed (the strip
+        targets it set are used); no normal matrix is assembled."""
+        here = Linearisation(self, state, residual, self._strip_targets,
+                             self._angle_columns(state.rot_e), self._extra_rows(state))
+        return here.apply_transpose(residual)
+
     def _closer_within_rounding(self, trial: State, energy: float, new_energy: float,
                                 decrement: float, factor: Factor) -> bool:
         """Whether a trial whose energy rose by no more than rounding (``ROUNDING`` × E,
@@ -818,10 +825,7 @@ class RigidBodySolver:
         what E no longer does."""
         if not new_energy - energy <= ROUNDING * energy:
             return False
-        residual = self._residuals_at_shapes(trial)
-        here = Linearisation(self, trial, residual, self._strip_targets,
-                             self._angle_columns(trial.rot_e), self._extra_rows(trial))
-        g = here.apply_transpose(residual)
+        g = self._gradient(trial, self._residuals_at_shapes(trial))
         t0 = time.perf_counter()
         trial_decrement = float(g @ factor.solve(g))
         self.solve_time += time.perf_counter() - t0
@@ -1188,11 +1192,9 @@ class RigidBodySolver:
         still contracting by 0.92, its straight creases 0.012° from the
         equilibrium a tolerance of 1e-13 reaches."""
         state = self._state()
-        residual = self._residuals(state)
-        here = Linearisation(self, state, residual, self._strip_targets,
-                             self._angle_columns(state.rot_e), self._extra_rows(state))
+        gradient = self._gradient(state, self._residuals(state))
         t0 = time.perf_counter()
-        v = self._normal_factor.solve(-here.apply_transpose(residual))
+        v = self._normal_factor.solve(-gradient)
         self.solve_time += time.perf_counter() - t0
         trial = self._apply(state, v)
         energy = self._trial_energy(trial)
