@@ -116,7 +116,7 @@ def test_an_interrupted_coarse_phase_ends_at_the_twins_state(monkeypatch):
     assert np.abs(sim.x - mesh.rest_positions).max() > 1e-3  # moved off the rest state
 
 
-def test_no_coarse_start_with_position_targets_or_from_a_folded_state(monkeypatch):
+def test_no_coarse_start_with_position_targets_or_from_a_state_the_mesh_reached(monkeypatch):
     pattern, mesh, _, _ = miura(3)
     monkeypatch.setattr(rigid_strategy, "COARSE_START", True)
     sim = Simulation(mesh, pattern)
@@ -124,11 +124,58 @@ def test_no_coarse_start_with_position_targets_or_from_a_folded_state(monkeypatc
     phases = []
     sim.run(tolerance=1e-6, callback=lambda s, m: phases.append(phase(s)))
     assert "coarse" not in phases
+    monkeypatch.setattr(rigid_strategy, "COARSE_START", False)
     sim = Simulation(mesh, pattern)
-    assert sim.run(tolerance=1e-6).converged
+    assert sim.run(tolerance=1e-6).converged  # the mesh's own steps
+    monkeypatch.setattr(rigid_strategy, "COARSE_START", True)
     sim.set_fold_percent(80.0)
     phases = []
     sim.run(tolerance=1e-6, callback=lambda s, m: phases.append(phase(s)))
+    assert phases and "coarse" not in phases
+
+
+def run_phases(sim, percent, tolerance=TOL):
+    sim.set_fold_percent(percent)
+    phases = []
+    result = sim.run(tolerance=tolerance, callback=lambda s, m: phases.append(phase(s)))
+    return result, phases
+
+
+def test_a_run_after_the_twins_certified_hand_over_goes_on_on_the_twin(monkeypatch):
+    """A sweep's next frame starts where the twin handed over (the mesh has not moved
+    since): it steps the twin again, predictor included, and ends at the mesh's
+    equilibrium as the mesh's own steps find it."""
+    pattern, mesh, expected, creases = miura(3)
+    size = Simulation(mesh, pattern).length_scale
+    runs = {}
+    for coarse in (False, True):
+        monkeypatch.setattr(rigid_strategy, "COARSE_START", coarse)
+        sim = Simulation(mesh, pattern)
+        first, _ = run_phases(sim, 40.0)
+        second, phases = run_phases(sim, 45.0)
+        assert sim.predict(1.0)  # the last two ends: 40 %, 45 %
+        third, phases3 = run_phases(sim, 50.0)
+        assert first.converged and second.converged and third.converged
+        assert ("coarse" in phases and "coarse" in phases3) == coarse
+        runs[coarse] = (second, third)
+    for plain, twin in zip(runs[False], runs[True]):
+        # each within the run's limit of the one equilibrium
+        assert np.abs(twin.positions - plain.positions).max() < 2 * TOL * size
+    angles = runs[True][1].fold_angles_deg[creases]
+    half = patterns.miura_fold_angles(3, 3, 60.0, 30.0)[creases] * 0.5
+    assert np.isfinite(angles).all() and np.sign(angles).tolist() == np.sign(half).tolist()
+
+
+def test_the_twin_is_left_once_the_mesh_moves_on_its_own(monkeypatch):
+    """After a certified hand-over, positions the mesh reached otherwise (here a bare
+    step of the finishing strategy) start the next run on the mesh itself."""
+    pattern, mesh, _, _ = miura(3)
+    monkeypatch.setattr(rigid_strategy, "COARSE_START", True)
+    sim = Simulation(mesh, pattern)
+    run_phases(sim, 40.0)
+    sim.set_fold_percent(45.0)
+    sim.step()
+    _, phases = run_phases(sim, 45.0)
     assert phases and "coarse" not in phases
 
 

@@ -98,3 +98,32 @@ def test_the_panel_motion_kernels_match_their_definitions():
     x = np.zeros((n_joints + 2, 3))
     rigid_normal.place_on_panels(rot, centre, np.arange(n_joints), panel, body, x)
     np.testing.assert_allclose(x[:n_joints], a + centre[panel], rtol=0, atol=1e-13)
+
+
+def test_place_sides_carries_a_shape_by_the_motion_that_fits_its_known_side():
+    """A bent strip moved rigidly: its known side where the motion put it, the other
+    side placed from the shape comes out where the same motion puts it (to rounding);
+    with the known side perturbed, the fit is the Procrustes one (SVD reference)."""
+    from foldcore import rigid_normal
+    from foldcore.rigid_body import exp_so3, procrustes
+
+    rng = np.random.default_rng(11)
+    b = 5
+    shape = rng.standard_normal((b, 8, 3)) * [3.0, 1.0, 0.1]  # mm, a strip's 8 points
+    rot = exp_so3(rng.standard_normal((b, 3)))
+    shift = 50.0 * rng.standard_normal((b, 1, 3))
+    moved = np.einsum("nij,nkj->nki", rot, shape) + shift
+    known = np.arange(8 * b).reshape(b, 8)[:, :4]
+    unknown = np.arange(8 * b).reshape(b, 8)[:, 4:]
+    x = np.zeros((8 * b, 3))
+    x[known] = moved[:, :4]
+    centre = shape[:, :4].mean(axis=1, keepdims=True)
+    rigid_normal.place_sides(x, known, unknown, shape[:, :4] - centre, shape[:, 4:] - centre)
+    np.testing.assert_allclose(x[unknown], moved[:, 4:], rtol=0, atol=1e-12)
+    x[known] += 0.05 * rng.standard_normal((b, 4, 3))
+    here = x[known]
+    rigid_normal.place_sides(x, known, unknown, shape[:, :4] - centre, shape[:, 4:] - centre)
+    fit = procrustes(here, shape[:, :4] - centre)
+    reference = np.einsum("nij,nkj->nki", fit, shape[:, 4:] - centre) \
+        + here.mean(axis=1, keepdims=True)
+    np.testing.assert_allclose(x[unknown], reference, rtol=0, atol=1e-11)

@@ -162,6 +162,7 @@ class RigidBodySolver:
         self.lam = LAMBDA_START
         self.jumped = self.follows_jump = False  # the last / the step before: extrapolated
         self.accepted, self.energy, self.decrease = False, np.inf, np.inf  # the last step's
+        self.energy_after = np.inf  # E after the last step (the kept state's), mm⁵
         self.gain_ratio, self.damped_share = np.nan, 0.0  # the last step's (step)
         self.contraction = np.nan  # its length over the last accepted one's, this run
         self._previous_velocity = None  # the last accepted plain step's velocity
@@ -366,9 +367,10 @@ class RigidBodySolver:
         columns, − on the right's (∂ρ/∂ω_L = d̂ = −∂ρ/∂ω_R, checked by differences)."""
         _, grad = self._mv_terms(rot_p)
         rows, cols, vals = [], [], []
+        wrong = grad.any(axis=1)  # the other rows are 0 (no M/V crease on its wrong side: all)
         for panels, sign in ((self.mv_left, 1.0), (self.mv_right, -1.0)):
             col = self.panel_col[panels]
-            moving = np.flatnonzero(col >= 0)
+            moving = np.flatnonzero((col >= 0) & wrong)
             for k in range(3):
                 rows.append(moving)
                 cols.append(col[moving] + k)
@@ -677,7 +679,7 @@ class RigidBodySolver:
         missing = rigid_normal.assemble(
             *lin.strip_args, self.n_loc, residual[:24 * s].reshape(s, 8, 3), self.rounds,
             self.crease_ptr, self.crease_strips, self.csc_indptr, self.csc_indices, data, lin.grad)
-        if lin.extra is not None:
+        if lin.extra is not None and lin.extra.nnz:  # (all zero: adds nothing)
             lin.grad += lin.extra.T @ residual[24 * s:]
             coo = sp.tril(lin.extra.T @ lin.extra, format="coo")  # the stored triangle
             missing += rigid_normal.add_entries(self.csc_indptr, self.csc_indices, data,
@@ -799,6 +801,8 @@ class RigidBodySolver:
         self._update_damping()
         self.decrease = energy - new_energy  # < 0 when rejected
         self.energy = energy
+        self.energy_after = new_energy if self.accepted else energy  # not E − decrease: that
+        #   rounds to 0 where the step took E from 1.9e-7 to 8e-24 (a sweep's frame)
         self.energy_scale = max(self.energy_scale, energy)
         return energy, moved
 
@@ -1026,12 +1030,10 @@ class RigidBodySolver:
         for batch, known, unknown in self._interior_chains():
             ids, bent = self.ids[batch], shape[batch]
             src, dst = (np.take_along_axis(ids, side, 1) for side in (known, unknown))
-            here = x[src]
             t_src = np.take_along_axis(bent, known[:, :, None], 1)
             t_dst = np.take_along_axis(bent, unknown[:, :, None], 1)
             centre = t_src.mean(axis=1, keepdims=True)
-            rot = procrustes(here, t_src - centre)
-            x[dst] = np.einsum("nij,nkj->nki", rot, t_dst - centre) + here.mean(axis=1)[:, None]
+            rigid_normal.place_sides(x, src, dst, t_src - centre, t_dst - centre)
         return x[self.free]
 
     def _interior_chains(self) -> list:
@@ -1093,7 +1095,7 @@ class RigidBodySolver:
             energy_limit = tolerance * self.energy + floor
             if self.distance_left(moved, limit, energy_limit if quiet else None) > limit:
                 return False
-            left = self.energy - self.decrease  # ≥ any later decrease
+            left = self.energy_after  # ≥ any later decrease
             return bool(min(self.decrease, left) <= energy_limit and quiet)
         if self.distance_left(moved, limit) > limit:
             return False
@@ -1163,10 +1165,10 @@ class RigidBodySolver:
             trial, energy, length = self._simplified_correction()
             theta = length / moved
             left = length * theta / (1.0 - theta) if theta < 1.0 else np.inf
-            if (energy <= self.energy - self.decrease and theta <= CONTRACTION_MAX
+            if (energy <= self.energy_after and theta <= CONTRACTION_MAX
                     and left <= limit and min(self.energy - energy, energy) <= energy_limit):
                 self._set_state(trial)
-                self.decrease = self.energy - energy
+                self.decrease, self.energy_after = self.energy - energy, energy
                 self.distance = left
             else:
                 self._update_shapes(self.phi)  # the kept state's shapes

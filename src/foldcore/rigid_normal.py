@@ -451,6 +451,33 @@ def fit_strip_rotations(ids, x, shape, rot_e):
 
 
 @njit(cache=True)
+def place_sides(x, known, unknown, shape_known, shape_unknown):
+    """Each strip's unknown vertices placed by the rigid motion that best fits its bent
+    shape's known side onto where those vertices are (Procrustes about the centroids).
+
+    Parameters
+    ----------
+    x : (N, 3) mm
+        Positions; the rows ``unknown`` are written.
+    known, unknown : (b, m) int
+        Vertex ids of each strip's placed side and of the side to place.
+    shape_known, shape_unknown : (b, m, 3) mm
+        The bent shape's points of those sides, both relative to the known side's
+        centroid.
+    """
+    for s in range(known.shape[0]):
+        c0, c1, c2 = centroid(x, known[s])
+        r00, r01, r02, r10, r11, r12, r20, r21, r22 = fit_about(x, known[s], shape_known[s],
+                                                                 c0, c1, c2)
+        for k in range(unknown.shape[1]):
+            t0, t1, t2 = shape_unknown[s, k, 0], shape_unknown[s, k, 1], shape_unknown[s, k, 2]
+            v = unknown[s, k]
+            x[v, 0] = r00 * t0 + r01 * t1 + r02 * t2 + c0
+            x[v, 1] = r10 * t0 + r11 * t1 + r12 * t2 + c1
+            x[v, 2] = r20 * t0 + r21 * t1 + r22 * t2 + c2
+
+
+@njit(cache=True)
 def carry_free(slot, panel, weight, y, c_old, rot_old, rot_new, c_new, out):
     """Free vertices moved by the blend of their panels' rigid motions (old → new).
 

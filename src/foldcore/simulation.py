@@ -297,6 +297,7 @@ class Simulation:
         self.equilibrium = EquilibriumCheck(self)  # the local/global strategies' verdict
         self._monitor = self._failure_monitor(strain_limits)
         self._bare_solve = None  # (K version, seconds) of the last bare-solve timing
+        self._last_fold_angles = None  # (positions, angles) of the last fold_angles call
         self.strategy = strategy(self)  # the one thing that moves self.x
 
     # ------------------------------------------------------------- actuation
@@ -669,7 +670,11 @@ class Simulation:
         panels = self.mesh.groups.get(self.mesh.panel_group)
         if panels is None or not len(panels):
             return np.full(self.pattern.n_edges, np.nan)
-        return fold_angles(self.pattern, self.mesh, self.x)
+        last = self._last_fold_angles  # a run's start measures where the last run ended
+        if last is None or not np.array_equal(last[0], self.x):
+            last = self._last_fold_angles = (self.x.copy(), fold_angles(self.pattern, self.mesh,
+                                                                        self.x))
+        return last[1].copy()
 
     def strip_angles(self) -> np.ndarray:
         """(S,) bend angle (degrees) each hinge sub-strip used in the last projection."""

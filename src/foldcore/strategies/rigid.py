@@ -16,8 +16,17 @@ the twin settled and the mesh's strips meet their bent shapes within the
 run's limit, else when the mesh's own steps settle. Meanwhile
 ``sim.x`` keeps the start positions (an interrupted run hands over first, so
 it ends at the twin's last state). Not for meshes whose creases are one
-strip wide already, with position targets (their vertex ids are the mesh's),
-or from any other start (a sweep's later frames start near their answer).
+strip wide already, or with position targets (their vertex ids are the mesh's).
+
+**A run that continues a certified hand-over** (the last run ended there and
+the mesh has not moved since: a fold-percent sweep's next frame) steps the
+kept twin again, the predictor included (:meth:`Rigid.predict` extrapolates
+the twin's run ends), and hands over under the same certificate. Any other
+start (positions the mesh reached by its own steps, or set) runs on the
+mesh, and the kept twin is freed. Why: a sweep's frames are one or two
+steps each, and the mesh's own steps cost ~6 ms at a thin Miura 8 × 8 (4
+sub-strips per crease) against the twin's ~3 ms; a 200-frame path took
+14 × one fold, now ~7 × (bench/paths.py, README).
 Measured (2-core Xeon guest, hybrid, tolerance 1e-8, 15 folds of the
 accuracy and convergence benchmarks): see :data:`COARSE_START`.
 """
@@ -58,6 +67,7 @@ class Rigid(Strategy):
         self.twin = None  # the coarse twin while it steps (module docstring)
         self._twin = None  # built on first use (False: this mesh has none)
         self._branch_done = False  # the twin settled the branch stage in progress
+        self._handed_x = None  # the mesh's state at a kept twin's hand-over (_continues)
         sim.x = self.engine.x
 
     @property
@@ -92,8 +102,11 @@ class Rigid(Strategy):
         if self._run != self.sim.runs:  # a new Simulation.run, not its second stage
             self._run = self.sim.runs
             self.engine.new_run()
-            if self._at_rest() and self._coarse_twin() is not None:
-                self.twin = self._twin  # fresh: each is dropped at its hand-over
+            continues = self._continues()
+            if not continues:
+                self._drop_twin()  # a kept twin whose state the mesh left
+            if (continues or self._at_rest()) and self._coarse_twin() is not None:
+                self.twin = self._twin
                 self.twin.engine.new_run()
         if self.twin is not None:
             self.twin.mirror(self.sim)  # this stage's targets and floors
@@ -102,6 +115,20 @@ class Rigid(Strategy):
         """Whether the run starts the coarse phase: enabled, no position targets, and
         the engine's positions at the rest state (:func:`at_rest`)."""
         return COARSE_START and at_rest(self.sim, self.engine.x)
+
+    def _continues(self) -> bool:
+        """Whether a kept twin can take this run's steps: the last run ended at its
+        certified hand-over (:meth:`settled`), the mesh's engine has not moved
+        since, and there are no position targets (their vertex ids are the mesh's).
+        A fold-percent sweep's frames go on on the twin this way."""
+        return (COARSE_START and self._handed_x is not None and not self.sim._position_targets
+                and np.array_equal(self.engine.x, self._handed_x))
+
+    def _drop_twin(self) -> None:
+        """Free the twin (built again from rest when a run needs it)."""
+        self.twin, self._handed_x = None, None
+        if self._twin:
+            self._twin = None  # (False, no twin for this mesh, stays)
 
     def _coarse_twin(self):
         """The mesh's coarse twin (:class:`foldcore.coarse.Twin`), built once; None
@@ -113,13 +140,17 @@ class Rigid(Strategy):
             self._twin = False if mesh is None else Twin(self.sim, mesh)
         return self._twin or None
 
-    def hand_over(self) -> None:
-        """End the coarse phase: the mesh's engine continues from the twin's state."""
+    def hand_over(self, keep: bool = False) -> None:
+        """End the coarse phase: the mesh's engine continues from the twin's state. The
+        twin is freed before the mesh's own step allocates (peak memory), unless
+        ``keep`` (the caller frees it if the mesh must step)."""
         if self.twin is None:
             return
         t0 = time.perf_counter()
         self.twin.hand_over(self.engine)
-        self.twin = self._twin = None  # freed before the mesh's own step allocates (peak memory)
+        self.twin = None
+        if not keep:
+            self._drop_twin()
         self._sync_sim()
         self.sim.timings["projection"] += time.perf_counter() - t0
 
@@ -149,10 +180,13 @@ class Rigid(Strategy):
         self.sim.equilibrium.residual = engine.distance / self.sim.length_scale
         if self.twin is not None:
             if (done or engine.stalls(moved, TWIN_STALL)) and self.sim.stage != "branch":
-                self.hand_over()
+                self.hand_over(keep=True)
                 if done and self.engine.strips_placed_within(limit):
-                    self.engine.record_end()  # the twin's verdict holds for the mesh
+                    engine.record_end()  # the twin's verdict holds for the mesh
+                    self.engine.record_end()
+                    self._handed_x = self.engine.x.copy()  # the next run may go on on it
                     return True
+                self._drop_twin()  # the mesh's own steps finish
                 return False
             self._branch_done = done
             return done
@@ -161,6 +195,11 @@ class Rigid(Strategy):
         return done
 
     def predict(self, ratio: float) -> bool:
+        """Extrapolate the last two run ends (:meth:`RigidBodySolver.predict`): on the
+        kept twin when the next run goes on on it (the mesh keeps its state until
+        the twin hands over), else on the mesh's engine."""
+        if self._continues():
+            return self._twin.engine.predict(ratio)
         if not self.engine.predict(ratio):
             return False
         self.sim.x = self.engine.x
