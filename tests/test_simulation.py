@@ -284,3 +284,27 @@ def test_angle_actuation_stiffens_the_actuated_strips_only():
     np.testing.assert_array_equal(equal.system.weights[equal._hinge_index], g.weights)
     with pytest.raises(SimulationError, match="unknown actuation 'motor'"):
         Simulation(mesh, pattern, actuation="motor")
+
+
+def test_k_is_factorised_at_its_first_use_and_then_matches_the_current_weights():
+    """A rigid-body fold never solves with K: it is not factorised (and the run reports
+    no bare-solve time). Weights and pins changed before the first use are in the
+    factor that use builds, as in one built from them at once."""
+    from foldcore.linsolve import Factor
+
+    pattern = patterns.degree4_vertex(radius=10.0, widths=[0.03] * 4, rho1=40.0)
+    mesh = thicken(pattern, 0.01)
+    sim = Simulation(mesh, pattern)
+    result = sim.run(tolerance=1e-8)
+    assert result.converged and not sim.system.factored
+    assert "bare_solve" not in result.timings_s
+    sim = Simulation(mesh, pattern, solver="lbfgs")
+    sim.add_position_target([3], alpha=2.0)  # new pins before K's first use
+    sim.set_fold_percent(50.0)
+    assert not sim.system.factored
+    result = sim.run(tolerance=0, max_iterations=2)
+    assert sim.system.factored and result.timings_s["bare_solve"] > 0
+    rhs = np.random.default_rng(3).standard_normal((mesh.n_vertices, 3))
+    fresh = Factor(sim.system._with_pins(), sim.system.backend)
+    np.testing.assert_allclose(sim.system.factor.solve(rhs), fresh.solve(rhs), rtol=1e-10,
+                               atol=1e-12 * np.abs(fresh.solve(rhs)).max())

@@ -80,7 +80,7 @@ class Twin:
 
         self.mesh = mesh
         self.sim = Simulation(mesh, sim.pattern, solver="rigid",
-                              backend=sim.system.factor.backend,
+                              backend=sim.system.backend,
                               stop_stiffness=sim._stop_factor,
                               actuation=sim.actuation, branch_floor_deg=0.0)
         self.engine = self.sim.strategy.engine

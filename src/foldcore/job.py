@@ -195,7 +195,7 @@ def fold(path, **options) -> Fold:
     settings.update(thickness_mm=thickness, hinge=sorted(set(mesh.hinge_model) - {""}),
                     actuation=o["actuation"], branch_floor_deg=o["branch_floor"],
                     elastic_cells_mm=cells,
-                    backend=sim.system.factor.backend)
+                    backend=sim.system.backend)
     outputs = {"-o": o["output"], "--report": o["report"], "--render": o["render"]}
     write_result(result, loaded.pattern, mesh, thickness, settings, fold=o["output"],
                  report=o["report"], png=o["render"], partial=interrupted,

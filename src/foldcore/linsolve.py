@@ -39,6 +39,17 @@ def cholmod_available() -> bool:
     return True
 
 
+def resolved_backend(backend: str) -> str:
+    """``"cholmod"`` or ``"scipy"`` for a backend name (``auto``: CHOLMOD when
+    scikit-sparse imports); ValueError for an unknown one."""
+    if backend == "auto":
+        backend = "cholmod" if cholmod_available() else "scipy"
+    if backend not in ("cholmod", "scipy"):
+        raise ValueError(f"unknown linear-solver backend {backend!r} "
+                         "(expected 'auto', 'cholmod' or 'scipy')")
+    return backend
+
+
 class Factor:
     """Factorisation of a sparse symmetric positive-definite matrix.
 
@@ -59,11 +70,7 @@ class Factor:
     """
 
     def __init__(self, matrix, backend: str = "auto", stored: str = "full"):
-        if backend == "auto":
-            backend = "cholmod" if cholmod_available() else "scipy"
-        if backend not in ("cholmod", "scipy"):
-            raise ValueError(f"unknown linear-solver backend {backend!r} "
-                             "(expected 'auto', 'cholmod' or 'scipy')")
+        backend = resolved_backend(backend)
         if stored not in ("full", "lower"):
             raise ValueError(f"unknown matrix storage {stored!r} (expected 'full' or 'lower')")
         self.backend, self.stored = backend, stored

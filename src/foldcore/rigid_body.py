@@ -154,7 +154,7 @@ class RigidBodySolver:
             raise SimulationError("solver 'rigid' needs rigid panels and bending hinges only "
                                   f"(mesh has {sorted(mesh.groups)}); use solver='paper'")
         self.sim = sim
-        self.backend = sim.system.factor.backend
+        self.backend = sim.system.backend
         self._weights_read = None  # the Simulation's strip-weight array sqrt_w was taken from
         self._init_panels(mesh.groups["rigid_panel"], mesh.n_vertices, sim.x)
         self._init_strips(sim._hinges)

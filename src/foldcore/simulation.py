@@ -73,8 +73,9 @@ class Result:
     timings_s : dict with ``setup``, ``projection`` (element kernels), ``solve`` (the
         rhs gather, the K⁻¹ solve and, for ``paper``, taking its result and
         largest move), ``total`` (setup + every :meth:`Simulation.run` so far)
-        and, after :meth:`Simulation.run`, ``bare_solve`` (one K⁻¹ solve, the
-        floor) (seconds)
+        and, after a :meth:`Simulation.run` where K was factorised (every
+        strategy but the rigid-body phase, which never solves with K),
+        ``bare_solve`` (one K⁻¹ solve, the floor) (seconds)
     strip_strains : (S, 2) float, top and bottom surface strain of each hinge
         sub-strip from its current shape (:mod:`foldcore.strain`), dimensionless
     failures : list of dict, hinges that exceeded their strain limits (first
@@ -560,7 +561,8 @@ class Simulation:
             finally:
                 self.stage = None
         self.timings["total"] += time.perf_counter() - start
-        self.timings["bare_solve"] = self._bare_solve_floor()
+        if self.system.factored:  # a rigid-body run never needs K (System.factor)
+            self.timings["bare_solve"] = self._bare_solve_floor()
         return self.result(reason == "converged", reason)
 
     def _stage(self, budget: int, callback, limit: float) -> tuple[int, str]:

@@ -177,7 +177,7 @@ class Newton(Strategy):
         analysis while the pattern stays (CHOLMOD ``cholesky_inplace``)."""
         matrix = self._pattern.matrix(values, self.lam)
         if self._factor is None:
-            self._factor = Factor(matrix, self.sim.system.factor.backend, stored="lower")
+            self._factor = Factor(matrix, self.sim.system.backend, stored="lower")
         else:
             self._factor.refactor(matrix)
         return self._factor.solve(rhs)
