@@ -267,3 +267,47 @@ def test_extrapolating_a_binding_tail_keeps_the_equilibrium(monkeypatch):
     assert jumped.iterations < plain.iterations
     assert jumped.energy[-1] == pytest.approx(plain.energy[-1], rel=1e-12)
     np.testing.assert_allclose(jumped.fold_angles_deg, plain.fold_angles_deg, atol=1e-4)
+
+
+def flat_miura6():
+    n, gamma = 6, 84.0
+    angles = patterns.miura_fold_angles(n, n, gamma, 90.0)
+    pattern = patterns.miura(n, n, a=A, b=A, gamma=gamma).replace(fold_angles=angles)
+    return pattern, thicken(pattern, 0.01 * A)
+
+
+def test_newton_at_its_resolution_ends_stalled_not_at_the_budget():
+    """Below the tolerance a binding fold resolves (the thick Miura 6 × 6 flat at
+    1e-13: limit 1.2e-11 mm), the rigid phase hands over to ``newton``, whose
+    steps then wander at ~1e-8 mm with E unchanged to rounding; they took the
+    whole 3 000-step budget (23 s). Now the run ends ``stalled`` once
+    ``STALL_STEPS`` accepted steps changed E by no more than rounding, and it is
+    not converged."""
+    from foldcore.strategies import newton
+
+    pattern, mesh = flat_miura6()
+    sim = Simulation(mesh, pattern)
+    result = sim.run(tolerance=1e-13, max_iterations=3000)
+    assert result.reason == "stalled" and not result.converged
+    assert result.iterations < 1000
+    tail = result.energy[-newton.STALL_STEPS:]
+    noise = newton.ROUNDING * result.energy.max() + sim.strategy.finish.energy_floor
+    assert np.ptp(tail) <= 2 * noise
+
+
+def test_steps_that_still_shrink_at_rounding_level_are_not_a_stall():
+    """The stall needs steps that no longer shrink: a tail contracting by 0.85 a step
+    within E's rounding is converging (the rigid phase's own test measured such
+    a tail, RigidBodySolver.stalls)."""
+    from foldcore.strategies import newton
+
+    pattern, mesh = flat_miura6()
+    strategy = newton.Newton(Simulation(mesh, pattern, solver="newton"))
+    n = newton.STALL_STEPS
+    strategy._level = n - 1
+    strategy._moves = [1e-8] * n
+    assert not strategy.stalled  # one step short of the count
+    strategy._level = n
+    assert strategy.stalled  # wandering at one size
+    strategy._moves = list(1e-8 * 0.85 ** np.arange(n))
+    assert not strategy.stalled

@@ -634,6 +634,8 @@ class Simulation:
                 return "callback"
             if self.strategy.settled(moved, limit):
                 return "converged"
+            if self.strategy.stalled:
+                return "stalled"
             if self.strategy.plain_map and self.equilibrium.hopeless(limit, budget - used):
                 return "stalled"
         return "stalled" if self.equilibrium.failed else "budget"

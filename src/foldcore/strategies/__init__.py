@@ -72,6 +72,13 @@ class Strategy:
     #: within its budget at that rate ends at once, ``stalled``.
     plain_map: bool = False
 
+    @property
+    def stalled(self) -> bool:
+        """Whether the steps are at the strategy's resolution: they no longer change the
+        energy beyond rounding and no longer shrink, so no budget would bring the
+        run closer; the run then ends ``stalled`` (default: never)."""
+        return False
+
     def __init_subclass__(cls, **kwargs):
         super().__init_subclass__(**kwargs)
         if cls.__dict__.get("abstract", False):

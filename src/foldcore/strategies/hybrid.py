@@ -124,6 +124,11 @@ class Hybrid(Strategy):
         self._start = None  # the rigid phase of a mesh in rings while it runs (_RigidStart)
 
     @property
+    def stalled(self) -> bool:
+        """The finishing strategy's verdict once the rigid phase has ended."""
+        return self.rigid is None and self._start is None and self.finish.stalled
+
+    @property
     def phase(self) -> str:
         return "rigid" if self.rigid is not None or self._start else self.finish.name
 
