@@ -88,7 +88,8 @@ class Result:
         the model binds (a vertex that cannot close, conflicting targets)
     reason : str, why the run ended: ``"converged"``; ``"stalled"`` (steps within the
         tolerance, or the plain map's rate too slow for the budget, but the
-        equilibrium not reached: :mod:`foldcore.verdict`); ``"budget"``
+        equilibrium not reached: :mod:`foldcore.verdict`; or the strategy's steps
+        at its resolution, :attr:`Strategy.stalled`); ``"budget"``
         (``max_iterations`` ran out); ``"callback"`` (the callback returned False);
         ``"interrupted"`` (Ctrl-C: :func:`foldcore.simulate` keeps the last iterate);
         ``"none"`` for a snapshot taken outside a run
