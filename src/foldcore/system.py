@@ -133,6 +133,9 @@ class System:
         dimensionless.
     weights : list of (n_g,) float
         Current element weights of each group, mm³.
+    backend : str
+        ``"cholmod"`` or ``"scipy"``: the backend the factor uses (resolved from
+        ``auto`` at construction, before any factorisation).
     version : int
         Number of refactorisations since construction: a change tells an
         accelerated strategy that K changed and its history is stale.
@@ -160,7 +163,7 @@ class System:
         """The factorisation of K with the pins, built at its first use. Why not at
         construction: the rigid-body strategies never solve with K, and at a thin
         Miura 50 × 50 (88 796 vertices, nnz(L) 2.0 M) it was 75 MB of the fold's
-        memory, and the coarse twin's own K another ~35 MB."""
+        memory (RSS), and the coarse twin's Simulation factorised its own."""
         if self._factor is None:
             self._factor = Factor(self._with_pins(), self.backend)
         return self._factor
