@@ -195,3 +195,18 @@ def test_a_binding_vertex_settles_from_the_twin_as_from_rest(solver, monkeypatch
     # its strips do not meet their shapes at the hand-over: the mesh's steps follow it
     assert phases[phases.index("coarse"):].count("rigid") >= 1
     assert np.nanmax(np.abs(results[0].fold_angles_deg - results[1].fold_angles_deg)) < 1e-4
+
+
+def test_a_fold_from_rest_frees_its_twins_factor_and_a_sweep_keeps_it(monkeypatch):
+    """The twin's normal factor is freed at the certified hand-over of a run from rest
+    (the mesh's certificate needs the memory at that peak); a sweep's next frames
+    build it once more and keep it (their steps reuse the analysis)."""
+    pattern, mesh, _, _ = miura(3)
+    monkeypatch.setattr(rigid_strategy, "COARSE_START", True)
+    sim = Simulation(mesh, pattern)
+    first, _ = run_phases(sim, 40.0)
+    rigid = sim.strategy._engine
+    assert first.converged and rigid._twin and rigid._twin.engine._normal_factor is None
+    second, phases = run_phases(sim, 45.0)
+    assert second.converged and "coarse" in phases
+    assert rigid._twin.engine._normal_factor is not None
