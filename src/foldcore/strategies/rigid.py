@@ -70,7 +70,6 @@ class Rigid(Strategy):
         self._twin = None  # built on first use (False: this mesh has none)
         self._branch_done = False  # the twin settled the branch stage in progress
         self._handed_x = None  # the mesh's state at a kept twin's hand-over (_continues)
-        self._from_rest = True  # this run's twin started at rest, not from a hand-over
         sim.x = self.engine.x
 
     @property
@@ -106,7 +105,6 @@ class Rigid(Strategy):
             self._run = self.sim.runs
             self.engine.new_run()
             continues = self._continues()
-            self._from_rest = not continues
             if not continues:
                 self._drop_twin()  # a kept twin whose state the mesh left
             if (continues or self._at_rest()) and self._coarse_twin() is not None:
@@ -185,8 +183,8 @@ class Rigid(Strategy):
         if self.twin is not None:
             if (done or engine.stalls(moved, TWIN_STALL)) and self.sim.stage != "branch":
                 self.hand_over(keep=True)
-                if self._from_rest:  # a single fold: the next run, if any, analyses anew
-                    engine.release_factor()
+                if self._handed_x is None:  # a fold from rest (a continued run keeps the
+                    engine.release_factor()  # last hand-over's): the next run analyses anew
                 if done and self.engine.strips_placed_within(limit):
                     engine.record_end()  # the twin's verdict holds for the mesh
                     self.engine.record_end()
