@@ -141,3 +141,25 @@ def test_a_step_reports_its_gain_ratio_and_damped_share():
         assert 0.0 <= engine.damped_share <= 1.0  # ‖Jv‖² and 2λvᵀDv are both ≥ 0
         if engine.accepted:  # E fell, the model predicted a fall: ρ ≥ 0
             assert engine.gain_ratio >= 0.0
+
+
+def test_mv_side_rows_are_continuous_through_a_flat_fold():
+    """An M/V side row's shape g(t), t the dihedral signed toward the assigned side:
+    0 on that side, t + slack crossing it, and 0 again at t = ±π (one dihedral: a
+    flat fold), continuous on the circle, its slope the derivative."""
+    from foldcore.rigid_body import MV_SLACK, mv_side
+
+    assigned = np.array([-0.5 * MV_SLACK, 0.0, 1.0, np.pi - 1e-12, np.pi])
+    value, slope = mv_side(assigned)
+    assert not value.any() and not slope.any()
+    value, slope = mv_side(np.array([-0.1]))
+    assert value[0] == pytest.approx(-0.1 + MV_SLACK, rel=1e-12) and slope[0] == 1.0
+    past_flat = mv_side(np.array([-np.pi + 1e-9]))[0]
+    assert abs(past_flat[0]) <= 2e-9  # not √μ·(−π): a valley a hair past flat
+    t = np.linspace(-np.pi + 1e-6, np.pi, 20001)
+    value, slope = mv_side(t)
+    assert np.abs(np.diff(value)).max() <= 1.01 * (t[1] - t[0])  # no jump anywhere
+    h = 1e-7
+    for point in (-0.3, -2.0, -3.0):
+        numeric = (mv_side(np.array([point + h]))[0] - mv_side(np.array([point - h]))[0]) / (2 * h)
+        assert numeric[0] == pytest.approx(mv_side(np.array([point]))[1][0], rel=1e-6)
