@@ -82,24 +82,36 @@ def rings_waterbomb(cell_mm: float):
 
 def test_hybrid_on_elastic_rings_starts_rigid_and_finishes_with_newton():
     """On faces in rings ``hybrid`` steps the rigid-panel twin from rest, places the
-    cells on it and finishes with Gauss–Newton: converged at the equilibrium that
-    L-BFGS creeps to (40 000 iterations, stalled), the same crease angles within
-    1e-4° (L-BFGS's creep is unfinished: its verdict stalls), in a 3-fold
-    symmetric state. The stretch hinge is refused by name."""
+    cells on it and finishes with Gauss–Newton: converged at a minimum of E in a
+    3-fold symmetric state. No crease reaches its ±40° (no rigid folding motion has
+    them equal), so E has two minima, images of each other under the pattern's
+    symmetry (sheet turned over, one crease round: every angle negated, the targets
+    carried onto themselves), and a 6-fold symmetric saddle between them (every
+    crease at ±9.08°, E = 0.833 mm⁵, 2.7× the minima). Which minimum a run reaches is
+    decided by rounding off that saddle, so the check is against Newton's minimum
+    under the symmetry: the same E to rounding and the same angles within 1e-6°.
+    L-BFGS does not get lower (on an AMD EPYC host it stalls on the saddle after
+    40 000 iterations). The stretch hinge is refused by name."""
     pattern, mesh = rings_waterbomb(5.0)
     sim = Simulation(mesh, pattern, solver="hybrid")
     phases = []
     result = sim.run(tolerance=1e-9, max_iterations=5_000,
                      callback=lambda s, moved: phases.append(s.strategy.phase))
     assert result.converged and isinstance(sim.strategy.finish, strategies.get("newton"))
-    reference = Simulation(mesh, pattern, solver="lbfgs").run(tolerance=1e-9,
-                                                              max_iterations=40_000)
-    np.testing.assert_allclose(result.fold_angles_deg[:6], reference.fold_angles_deg[:6],
-                               atol=1e-4)
+    assert phases[0] == "rigid" and phases[-1] == "newton"
     angles = result.fold_angles_deg[:6]
     np.testing.assert_allclose(angles[::2], angles[0], atol=1e-6)
     np.testing.assert_allclose(angles[1::2], angles[1], atol=1e-6)
-    assert phases[0] == "rigid" and phases[-1] == "newton"
+    newton = Simulation(mesh, pattern, solver="newton").run(tolerance=1e-9,
+                                                            max_iterations=500)
+    assert newton.converged
+    np.testing.assert_allclose(result.energy[-1], newton.energy[-1], rtol=1e-9)
+    reached = newton.fold_angles_deg[:6]
+    images = (reached, -np.roll(reached, 1))  # itself, and turned over one crease round
+    assert min(np.abs(angles - image).max() for image in images) <= 1e-6
+    lbfgs = Simulation(mesh, pattern, solver="lbfgs").run(tolerance=1e-9,
+                                                          max_iterations=2_000)
+    assert lbfgs.energy[-1] >= result.energy[-1] * (1 - 1e-9)
     plain = patterns.waterbomb(radius=30.0, width=1.0)
     stretchy = thicken(plain, 0.5, subdivisions=2, stretch={0: 0.3})
     with pytest.raises(SimulationError, match="solver 'newton' takes"):
