@@ -35,9 +35,19 @@ Miura 20 × 20 and 50 × 50. Cold: Miura 10 × 10 under the default strategy wit
 The machine is shared: the share of the cores other processes used is
 recorded before each run (``others_busy``).
 
+Memory, fixed and marginal (``--memory``; stored under ``memory``): the
+growth above counts what any first fold in a process pays once (numba's and
+LLVM's runtime, the first call of each kernel: ≈ 0.1 GB whatever the size),
+so per thick vertex it overstates what a bigger sheet costs. A fresh process
+per size folds a small warm-up sheet (``WARMUP_CASE``) with the default
+strategy first, then the case; reported: the RSS before anything (``start``),
+after the warm-up (``fixed_mb`` = its growth) and the case's peak growth over
+the RSS after the warm-up, per thick vertex (``marginal_kb_per_vertex``).
+
 Writes bench/results/time_to_solution.json and .png; ``--table`` prints the
-README's table from the JSON; ``--rerun lbfgs`` runs only the strategies named
-(comma-separated) again and replaces their rows.
+README's table from the JSON (and the memory table when measured); ``--rerun
+lbfgs`` runs only the strategies named (comma-separated) again and replaces
+their rows; ``--memory`` runs the memory probes and stores them.
 
 Run: ``.venv/bin/python bench/time_to_solution.py`` (~15 min).
 """
@@ -64,6 +74,8 @@ RUNS = 3
 CASES = ("vertex", "waterbomb", "miura10", "miura20", "miura50")
 ONE_RUN = ("miura20", "miura50")
 BARE_SOLVES = 20
+WARMUP_CASE = "miura4"
+MEMORY_CASES = ("miura10", "miura20", "miura50")
 
 
 def make_case(name: str):
@@ -116,6 +128,62 @@ def probe(case: str, strategy: str) -> dict:
             "bare_solve_s": statistics.median(solves), "thick_vertices": int(mesh.n_vertices),
             "peak_rss_mb": peak, "rss_growth_mb": peak - before,
             "kb_per_thick_vertex": (peak - before) * 1024.0 / mesh.n_vertices}
+
+
+def memory_probe(case: str) -> dict:
+    """Fixed and marginal memory of a hybrid fold of ``case`` (module docstring)."""
+    from foldcore.simulation import Simulation
+
+    start = current_rss_mb()
+    pattern, mesh, _, _ = make_case(WARMUP_CASE)
+    Simulation(mesh, pattern).run(tolerance=TOLERANCE, max_iterations=BUDGET)
+    del pattern, mesh
+    warm = current_rss_mb()
+    pattern, mesh, expected, creases = make_case(case)
+    result = Simulation(mesh, pattern).run(tolerance=TOLERANCE, max_iterations=BUDGET)
+    peak = peak_rss_mb()
+    error = float(np.abs(result.fold_angles_deg[creases] - expected).max())
+    return {"case": case, "warmup_case": WARMUP_CASE, "thick_vertices": int(mesh.n_vertices),
+            "start_mb": start, "fixed_mb": warm - start, "peak_rss_mb": peak,
+            "marginal_mb": peak - warm,
+            "marginal_kb_per_vertex": (peak - warm) * 1024.0 / mesh.n_vertices,
+            "iterations": int(result.iterations), "error_deg": error}
+
+
+def memory() -> None:
+    """Run ``memory_probe`` per size in fresh processes; store under ``memory``."""
+    from _meta import machine_meta
+
+    rows = []
+    for case in MEMORY_CASES:
+        out = subprocess.run([sys.executable, __file__, "--memory-probe", case],
+                             capture_output=True, text=True, check=True)
+        row = json.loads(out.stdout.strip().splitlines()[-1])
+        print(f"  {case:9s} fixed {row['fixed_mb']:.1f} MB  marginal {row['marginal_mb']:.1f} MB"
+              f" = {row['marginal_kb_per_vertex']:.2f} kB/vertex  peak {row['peak_rss_mb']:.0f} MB",
+              flush=True)
+        rows.append(row)
+    path = RESULTS / "time_to_solution.json"
+    data = json.loads(path.read_text())
+    data["memory"] = {"meta": {**machine_meta(), "date": time.strftime("%Y-%m-%d")},
+                      "rows": rows}
+    path.write_text(json.dumps(data, indent=1))
+    print(memory_table())
+
+
+def memory_table(path: Path = RESULTS / "time_to_solution.json") -> str:
+    """README table of the memory probes: fixed MB, marginal MB and kB per thick vertex."""
+    from _meta import markdown_table
+
+    data = json.loads(path.read_text())
+    if "memory" not in data:
+        return ""
+    return markdown_table(
+        ["case", "thick vertices", "fixed (MB)", "marginal (MB)", "marginal kB / thick vertex",
+         "peak RSS (MB)"],
+        [[r["case"], f"{r['thick_vertices']:,}", f"{r['fixed_mb']:.0f}",
+          f"{r['marginal_mb']:.1f}", f"{r['marginal_kb_per_vertex']:.2f}",
+          f"{r['peak_rss_mb']:.0f}"] for r in data["memory"]["rows"]])
 
 
 def run_probe(case: str, strategy: str, env=None) -> dict:
@@ -260,9 +328,15 @@ def main() -> None:
 if __name__ == "__main__":
     if len(sys.argv) > 1 and sys.argv[1] == "--probe":
         print(json.dumps(probe(sys.argv[2], sys.argv[3])))
+    elif len(sys.argv) > 1 and sys.argv[1] == "--memory-probe":
+        print(json.dumps(memory_probe(sys.argv[2])))
+    elif len(sys.argv) > 1 and sys.argv[1] == "--memory":
+        sys.path.insert(0, str(HERE))
+        memory()
     elif len(sys.argv) > 1 and sys.argv[1] == "--table":
         sys.path.insert(0, str(HERE))
         print(table())
+        print(memory_table())
     elif len(sys.argv) > 2 and sys.argv[1] == "--rerun":
         sys.path.insert(0, str(HERE))
         rerun(sys.argv[2].split(","))
