@@ -145,13 +145,9 @@ def mv_side(t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     stopped 13.4° short at slopes 1e6 and 1e8 and folds flat to 6e-9° at 1.
     Slope 1 still stops the chain scene's zig-zag creases at 180.006° (with
     no rows they fold on to 206°)."""
-    t = np.asarray(t, float)
-    wall = MV_WALL
-    turn = -(wall * np.pi + MV_SLACK) / (1.0 + wall)  # where the two branches meet
-    crossing = (t < -MV_SLACK) & (t >= turn)
-    back = t < turn
-    value = np.where(crossing, t + MV_SLACK, np.where(back, -(t + np.pi) * wall, 0.0))
-    slope = np.where(crossing, 1.0, np.where(back, -wall, 0.0))
+    t = np.ascontiguousarray(t, dtype=float).ravel()
+    value, slope = np.empty_like(t), np.empty_like(t)
+    rigid_normal.mv_side_many(t, MV_WALL, MV_SLACK, value, slope)
     return value, slope
 
 
@@ -382,24 +378,21 @@ class RigidBodySolver:
             * mesh.hinge_width[crease]
 
     def _mv_terms(self, rot_p):
-        """(residual rows (C,), ∂ρ/∂ω of the left panel (C, 3)) of the M/V side rows."""
-        left, right = rot_p[self.mv_left], rot_p[self.mv_right]
-        d = np.einsum("nij,nj->ni", left + right, self.mv_axis)
-        d /= np.linalg.norm(d, axis=1)[:, None]
-        n_l, n_r = left[:, :, 2], right[:, :, 2]
-        rho = np.arctan2(np.einsum("ni,ni->n", np.cross(n_r, n_l), d),
-                         np.einsum("ni,ni->n", n_l, n_r))
-        value, slope = mv_side(self.mv_sign * rho)
-        wrong = slope != 0.0
-        return self.mv_sqrt * value, \
-            np.where(wrong[:, None], (self.mv_sqrt * self.mv_sign * slope)[:, None] * d, 0.0)
+        """(residual rows (C,), ∂ρ/∂ω of the left panel (C, 3)) of the M/V side rows
+        (:func:`foldcore.rigid_normal.mv_terms`)."""
+        value, grad = np.empty(len(self.mv_sign)), np.empty((len(self.mv_sign), 3))
+        rigid_normal.mv_terms(rot_p, self.mv_left, self.mv_right, self.mv_axis, self.mv_sign,
+                              self.mv_sqrt, MV_WALL, MV_SLACK, value, grad)
+        return value, grad
 
     def _mv_rows(self, rot_p, n_columns: int):
         """(C, n_unknowns) Jacobian of the M/V rows: +∂ on the left panel's rotation
         columns, − on the right's (∂ρ/∂ω_L = d̂ = −∂ρ/∂ω_R, checked by differences)."""
         _, grad = self._mv_terms(rot_p)
-        rows, cols, vals = [], [], []
         wrong = grad.any(axis=1)  # the other rows are 0 (no M/V crease on its wrong side: all)
+        if not wrong.any():
+            return sp.csr_matrix((len(self.mv_sign), n_columns))
+        rows, cols, vals = [], [], []
         for panels, sign in ((self.mv_left, 1.0), (self.mv_right, -1.0)):
             col = self.panel_col[panels]
             moving = np.flatnonzero((col >= 0) & wrong)
@@ -696,7 +689,9 @@ class RigidBodySolver:
                                     sp.csr_matrix((pins.shape[0], n_hinge))]))
         if len(self.mv_sign):
             parts.append(self._mv_rows(state.rot_p, self.n_unknowns))
-        return sp.vstack(parts).tocsr() if parts else None
+        if len(parts) < 2:
+            return parts[0].tocsr() if parts else None
+        return sp.vstack(parts).tocsr()
 
     def _linearise(self, state: State) -> "Linearisation":
         """JᵀJ (values on the fixed pattern), Jᵀr and r at a state, without forming J for

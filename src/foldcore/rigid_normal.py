@@ -564,3 +564,64 @@ def place_on_panels(rot_p, c_p, vertex, panel, body, x):
         for d in range(3):
             x[v, d] = (rot_p[p, d, 0] * body[n, 0] + rot_p[p, d, 1] * body[n, 1]
                        + rot_p[p, d, 2] * body[n, 2] + c_p[p, d])
+
+
+@njit(cache=True, inline="always")
+def mv_side_at(t, wall, slack):
+    """(value, slope) of an M/V side row's shape at ``t`` rad (one crease; the
+    shape and why: :func:`foldcore.rigid_body.mv_side`)."""
+    turn = -(wall * math.pi + slack) / (1.0 + wall)  # where the two branches meet
+    if t < -slack and t >= turn:
+        return t + slack, 1.0
+    if t < turn:
+        return -(t + math.pi) * wall, -wall
+    return 0.0, 0.0
+
+
+@njit(cache=True)
+def mv_terms(rot_p, left, right, axis, sign, sqrt_mv, wall, slack, value, grad):
+    """M/V side rows of the creases (C,) between panels ``left`` and ``right``.
+
+    Per crease: d̂ = the unit of (R_L + R_R)·axis (the crease's direction, its
+    panels' mean); ρ = atan2((n_R × n_L)·d̂, n_L·n_R), the panels' dihedral
+    about d̂ (n = each rotation's third column); the row is √μ·v(sign·ρ) and
+    its derivative along the left panel's rotation √μ·sign·v′(sign·ρ)·d̂
+    (:func:`mv_side_at`: v, v′).
+
+    Parameters
+    ----------
+    rot_p : (P, 3, 3) panel rotations
+    left, right : (C,) int64 panel of each crease's two sides
+    axis : (C, 3) crease direction in the flat pattern, mm
+    sign : (C,) +1 valley, −1 mountain
+    sqrt_mv : (C,) √ of each row's weight
+    wall, slack : the shape's constants (``MV_WALL``, ``MV_SLACK``)
+    value : (C,) written: the rows
+    grad : (C, 3) written: ∂row/∂ω_L (0 where the row is flat)
+    """
+    d = np.empty(3)
+    for c in range(len(left)):
+        rl, rr = rot_p[left[c]], rot_p[right[c]]
+        for i in range(3):
+            d[i] = (rl[i, 0] + rr[i, 0]) * axis[c, 0] + (rl[i, 1] + rr[i, 1]) * axis[c, 1] \
+                + (rl[i, 2] + rr[i, 2]) * axis[c, 2]
+        norm = math.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
+        for i in range(3):
+            d[i] /= norm
+        l0, l1, l2 = rl[0, 2], rl[1, 2], rl[2, 2]
+        r0, r1, r2 = rr[0, 2], rr[1, 2], rr[2, 2]
+        sine = (r1 * l2 - r2 * l1) * d[0] + (r2 * l0 - r0 * l2) * d[1] \
+            + (r0 * l1 - r1 * l0) * d[2]
+        rho = math.atan2(sine, l0 * r0 + l1 * r1 + l2 * r2)
+        v, slope = mv_side_at(sign[c] * rho, wall, slack)
+        value[c] = sqrt_mv[c] * v
+        scale = sqrt_mv[c] * sign[c] * slope
+        for i in range(3):
+            grad[c, i] = scale * d[i] if slope != 0.0 else 0.0
+
+
+@njit(cache=True)
+def mv_side_many(t, wall, slack, value, slope):
+    """:func:`mv_side_at` at every ``t`` (C,): ``value``, ``slope`` (C,) written."""
+    for c in range(len(t)):
+        value[c], slope[c] = mv_side_at(t[c], wall, slack)
