@@ -307,6 +307,26 @@ SHAPE_STEP = 1e-6  # rad, central-difference step of ``shapes``' derivative
 
 
 @njit(parallel=True, cache=True)
+def bent_shapes(indptr, rest, params, phi, out):
+    """Bent shapes T(φ) of every sub-strip (local frame): :func:`shapes` without the
+    derivative, one bend per strip instead of three (the same arithmetic, so
+    the same ``out`` to the last bit). For the rigid strategy's energy
+    evaluations, which need no Jacobian.
+
+    Parameters
+    ----------
+    indptr : (S+1,) int64, slots of each strip
+    rest : (nnz, 3) centred rest shapes, mm
+    params : (S, 9) see ``HINGE_PARAMS``
+    phi : (S,) bend angle per strip, rad
+    out : (nnz, 3) written: T(φ), mm
+    """
+    for e in prange(len(indptr) - 1):
+        s, t = indptr[e], indptr[e + 1]
+        bend(rest[s:t], params[e], phi[e], params[e, STRIPS] * phi[e], out[s:t])
+
+
+@njit(parallel=True, cache=True)
 def shapes(indptr, rest, params, phi, out, d_out):
     """Bent shapes T(φ) and their derivatives dT/dφ for every sub-strip (local frame).
 
