@@ -165,29 +165,26 @@ def test_mv_side_rows_are_continuous_through_a_flat_fold():
         assert numeric[0] == pytest.approx(mv_side(np.array([point]))[1][0], rel=1e-6)
 
 
-def test_bent_shapes_and_their_lazy_derivative_match_the_eager_kernel():
-    """The energy path's one-bend shapes and the derivative computed on demand are
-    :func:`shapes`' own, bit for bit, and dT/dφ agrees with a difference of the
-    shapes over a step of 1e-4 rad to its truncation (~1e-8·W)."""
-    from elements.bending_hinge import shapes
+def test_shape_derivatives_are_the_central_difference_of_the_bent_shapes():
+    """dT/dφ, computed on demand, is bent_shapes' central difference over
+    ``SHAPE_STEP`` bit for bit, agrees with one over 1e-4 rad to its truncation
+    (~1e-8·W), and follows a new angle."""
+    from elements.bending_hinge import SHAPE_STEP
 
     pattern, mesh = long_hinge(4.0, angle=70.0)
-    sim = Simulation(mesh, pattern, solver="rigid")
-    engine = sim.strategy.engine
-    g = engine.hinges.group
+    engine = Simulation(mesh, pattern, solver="rigid").strategy.engine
     phi = np.linspace(0.3, 1.1, len(engine.ids))
-    out, d_out = np.empty_like(engine.shape), np.empty_like(engine.shape)
-    shapes(g.indptr, g.rest, engine.hinges.params, phi, out, d_out)
+
+    def shape_at(angles):
+        engine._update_shapes(angles)
+        return engine.shape.copy()
+
+    exact = (shape_at(phi + SHAPE_STEP) - shape_at(phi - SHAPE_STEP)) / (2.0 * SHAPE_STEP)
+    coarse = (shape_at(phi + 1e-4) - shape_at(phi - 1e-4)) / 2e-4
     engine._update_shapes(phi)
-    assert np.array_equal(engine.shape, out)
-    assert np.array_equal(engine._shape_derivatives(), d_out)
-    step = 1e-4
-    engine._update_shapes(phi + step)
-    up = engine.shape.copy()
-    engine._update_shapes(phi - step)
-    central = (up - engine.shape) / (2 * step)
+    d_shape = engine._shape_derivatives().copy()
+    assert np.array_equal(d_shape, exact)
     width = float(np.nanmax(mesh.hinge_width))
-    assert np.abs(central - d_out).max() < 1e-6 * width
-    assert not np.array_equal(engine._shape_derivatives(), d_out)  # at φ − step
-    engine._update_shapes(phi)  # a new angle makes the kept derivative stale
-    assert np.array_equal(engine._shape_derivatives(), d_out)
+    assert np.abs(coarse - d_shape).max() < 1e-6 * width
+    engine._update_shapes(phi - 1e-4)  # a new angle makes the kept derivative stale
+    assert not np.array_equal(engine._shape_derivatives(), d_shape)

@@ -303,15 +303,15 @@ def prepared_batch(x, indptr, indices, rest, shapes, params, out, energy, state)
             energy[e] = fit_rotated(x, indices[s:t], shapes[s:t], out[s:t])
 
 
-SHAPE_STEP = 1e-6  # rad, central-difference step of ``shapes``' derivative
+SHAPE_STEP = 1e-6  # rad, central-difference step of :func:`shape_derivatives`
 
 
 @njit(parallel=True, cache=True)
 def bent_shapes(indptr, rest, params, phi, out):
-    """Bent shapes T(φ) of every sub-strip (local frame): :func:`shapes` without the
-    derivative, one bend per strip instead of three (the same arithmetic, so
-    the same ``out`` to the last bit). For the rigid strategy's energy
-    evaluations, which need no Jacobian.
+    """Bent shapes T(φ) of every sub-strip (local frame), for the rigid-body
+    strategy; their derivative is :func:`shape_derivatives`, apart, because
+    most of that strategy's shape updates are energy evaluations that need no
+    Jacobian.
 
     Parameters
     ----------
@@ -327,14 +327,15 @@ def bent_shapes(indptr, rest, params, phi, out):
 
 
 @njit(parallel=True, cache=True)
-def shapes(indptr, rest, params, phi, out, d_out):
-    """Bent shapes T(φ) and their derivatives dT/dφ for every sub-strip (local frame).
+def shape_derivatives(indptr, rest, params, phi, scratch, d_out):
+    """Derivatives dT/dφ of every sub-strip's bent shape (local frame).
 
     For solvers that treat each strip's bend angle as an unknown (the
-    rigid-body strategy). dT/dφ is a central difference of :func:`bent_shape`
-    with step ``SHAPE_STEP`` (truncation ~1e-12·W, round-off ~1e-10·W: ample
-    for a Jacobian), so it stays consistent with the target whatever the
-    shape rule. Allocates nothing: ``out`` is used as scratch first.
+    rigid-body strategy; its shapes T(φ) come from :func:`bent_shapes`).
+    dT/dφ is a central difference of :func:`bent_shape` with step
+    ``SHAPE_STEP`` (truncation ~1e-12·W, round-off ~1e-10·W: ample for a
+    Jacobian), so it stays consistent with the target whatever the shape
+    rule. Allocates nothing.
 
     Parameters
     ----------
@@ -342,7 +343,7 @@ def shapes(indptr, rest, params, phi, out, d_out):
     rest : (nnz, 3) centred rest shapes, mm
     params : (S, 9) see ``HINGE_PARAMS``
     phi : (S,) bend angle per strip, rad (the strips of a crease alike)
-    out : (nnz, 3) written: T(φ), mm
+    scratch : (nnz, 3) overwritten (the shapes at φ − ``SHAPE_STEP``), mm
     d_out : (nnz, 3) written: dT/dφ, mm/rad
     """
     for e in prange(len(indptr) - 1):
@@ -350,11 +351,10 @@ def shapes(indptr, rest, params, phi, out, d_out):
         strips = params[e, STRIPS]  # the rigid strategy bends a crease's strips alike
         up, down = phi[e] + SHAPE_STEP, phi[e] - SHAPE_STEP
         bend(rest[s:t], params[e], up, strips * up, d_out[s:t])
-        bend(rest[s:t], params[e], down, strips * down, out[s:t])
+        bend(rest[s:t], params[e], down, strips * down, scratch[s:t])
         for k in range(s, t):
             for d in range(3):
-                d_out[k, d] = (d_out[k, d] - out[k, d]) / (2.0 * SHAPE_STEP)
-        bend(rest[s:t], params[e], phi[e], strips * phi[e], out[s:t])
+                d_out[k, d] = (d_out[k, d] - scratch[k, d]) / (2.0 * SHAPE_STEP)
 
 
 class BendingHinge(ElementType):

@@ -36,7 +36,8 @@ from typing import NamedTuple
 import numpy as np
 import scipy.sparse as sp
 
-from elements.bending_hinge import FLOOR, MAX_ANGLE, SIGN, TARGET, bent_shapes, estimate_angles, shapes
+from elements.bending_hinge import (FLOOR, MAX_ANGLE, SIGN, TARGET, bent_shapes, estimate_angles,
+                                    shape_derivatives)
 from .errors import SimulationError
 from . import rigid_normal
 from .linsolve import Factor
@@ -576,12 +577,11 @@ class RigidBodySolver:
 
     def _shape_derivatives(self) -> np.ndarray:
         """(S·8, 3) dT/dφ, mm/rad, at the angles of the last :meth:`_update_shapes`
-        (computed on first use after it; the values it rewrites into scratch are
-        ``self.shape``'s, bit for bit)."""
+        (computed on first use after it)."""
         if not self._d_shape_current:
             g = self.hinges.group
-            shapes(g.indptr, g.rest, self.hinges.params, self._shape_phi, self._shape_scratch,
-                   self.d_shape)
+            shape_derivatives(g.indptr, g.rest, self.hinges.params, self._shape_phi,
+                              self._shape_scratch, self.d_shape)
             self._d_shape_current = True
         return self.d_shape
 
@@ -692,7 +692,8 @@ class RigidBodySolver:
         """(S, 8, 3) ∂(R T_k)/∂(crease angle) of passive strips (−R ∂T_k/∂φ / k), 0 else."""
         pas = self.passive_ids
         out = np.zeros((len(self.ids), 8, 3))
-        out[pas] = np.einsum("sij,skj->ski", rot_e[pas], self._shape_derivatives().reshape(-1, 8, 3)[pas]) \
+        d_shape = self._shape_derivatives().reshape(-1, 8, 3)
+        out[pas] = np.einsum("sij,skj->ski", rot_e[pas], d_shape[pas]) \
             * (-1.0 / self.k_strip[pas])[:, None, None]
         return out
 
