@@ -699,6 +699,28 @@ def test_widths_too_large_for_face_named():
     check_mesh(pattern, mesh, 1.0)
 
 
+def tee():
+    """A 2 × 2 mm sheet whose lower face (face 0) has a straight side through vertex
+    3: creases 2 and 3 meet there in line (both sides of face 0), crease 9 goes up."""
+    v = [(0, 0), (2, 0), (2, 1), (1, 1), (0, 1), (0, 2), (1, 2), (2, 2)]
+    e = [(0, 1), (1, 2), (2, 3), (3, 4), (4, 0), (4, 5), (5, 6), (6, 7), (7, 2), (3, 6)]
+    return CreasePattern(v, e, ["B", "B", "V", "V", "B", "B", "B", "B", "B", "M"],
+                         source="tee")
+
+
+def test_collinear_sides_of_unequal_width_named():
+    # a panel corner at a straight vertex exists only if both sides are offset alike
+    pattern = tee()
+    (face,) = set(pattern.edge_faces[2].tolist()) & set(pattern.edge_faces[3].tolist())
+    widths = np.full(pattern.n_edges, 0.05)
+    widths[9] = 0.08  # the crossing crease may differ
+    check_mesh(pattern, thicken(pattern, 0.01, hinge_width=widths), 0.01)
+    widths[2] = 0.08  # the two in line may not
+    with pytest.raises(MeshError, match=rf"tee: face {face}: two collinear sides at vertex 3 "
+                                        "have different hinge widths"):
+        thicken(pattern, 0.01, hinge_width=widths)
+
+
 def short_crease():
     """Crease 6 (vertex 0 → 1, 1 mm) crosses a thin sheet at 30° to its sides: each
     end has an acute panel corner on one side only, so the strip loses
