@@ -1,0 +1,365 @@
+"""Origami Simulator beside foldcore on its own Miura, folded flat, in one run (issue 17).
+
+Issue 17's first target: Origami Simulator's ``Tessellations/miura-ori.svg``
+folded flat (100 %) converged in ≤ 0.5 s, ≥ 10 × faster than Origami Simulator
+*in the same run*. This benchmark runs both, interleaved, ``ROUNDS`` rounds:
+
+* **Origami Simulator** (Amanda Ghassaei, MIT licence; not part of this
+  project: read from a snapshot of github.com/amandaghassaei/OrigamiSimulator,
+  a bare git dir or a checkout, ``--origami-simulator``): its own page, served
+  from 127.0.0.1, in Debian's headless Chromium with software WebGL
+  (SwiftShader, the flags of tests/test_view.py), with a harness script
+  added after its ``main.js`` (and the analytics script it loads from
+  Google left out: no network). The page loads its demo ``Tessellations/miura-ori.svg`` (182
+  nodes) with its default settings; once the model is built the harness
+  pauses the animation loop, resets the solver to the flat sheet, sets the
+  fold to 100 % and calls ``globals.model.step()`` (its per-frame work:
+  ``numSteps`` = 100 solver steps and the read-back that gives the mean
+  node strain shown as "global error") until the mean strain is below each
+  of ``STRAINS`` (percent) or ``OS_LIMIT_S`` passes (a threshold counts once
+  the strain has risen to the first one: the sheet starts flat and unstrained). Time is
+  ``performance.now()`` from the first step; the drawing of the scene is not
+  counted (in the app every 100 steps also draw a frame), so Origami
+  Simulator's times here are lower bounds of what its users wait for. At
+  each threshold the node positions are taken, and the fold angle of every
+  M/V crease is measured from them (Python side: the angle between the two
+  triangles' normals) against its target (±180°).
+* **foldcore**: the same layout as ``bench/os_miura.py``'s
+  "arc, graded W, H = 0.01a" row (Miura 12 × 13, a = 80 mm, γ = 84°, arc
+  hinges with graded widths, every crease driven to its closed form,
+  default strategy, tolerance 1e-9), warm numba cache, one warm-up fold in
+  this process first; ``seconds`` is ``Simulation(...).run()`` (the mesh
+  is built once, outside the timing, as for Origami Simulator's page load).
+
+Reported per round: both times, their ratio (Origami Simulator / foldcore),
+Origami Simulator's steps, strain and angle error at each threshold, and
+foldcore's iterations and misses; ``others_busy`` before each run (share of
+the cores other processes used). Writes bench/results/origami_simulator.json
+and .png (Origami Simulator's mean strain against time, foldcore's fold time
+marked). Run: ``.venv/bin/python bench/origami_simulator.py
+[--origami-simulator PATH]`` (~2 min; needs /usr/bin/chromium, which
+``make test`` installs).
+"""
+from __future__ import annotations
+
+import argparse
+import http.server
+import json
+import os
+import queue
+import shutil
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+
+HERE = Path(__file__).resolve().parent
+RESULTS = HERE / "results"
+sys.path.insert(0, str(HERE))
+from _meta import machine_meta, markdown_table  # noqa: E402
+
+DEFAULT_SOURCE = Path("/work/.mirror/amandaghassaei+OrigamiSimulator/repo")
+MODEL = "Tessellations/miura-ori.svg"
+CHROMIUM = "/usr/bin/chromium"
+FLAGS = ["--headless", "--no-sandbox", "--disable-gpu", "--enable-unsafe-swiftshader",
+         "--use-angle=swiftshader", "--disable-background-networking",
+         "--disable-component-update", "--disable-sync", "--no-first-run",
+         "--disable-background-timer-throttling", "--disable-renderer-backgrounding",
+         "--window-size=1280,800"]
+ROUNDS = 3
+STRAINS = (0.01, 0.001)  # mean node strain thresholds, percent (the issue's)
+OS_LIMIT_S = 60.0        # Origami Simulator gives up after this long
+PAGE_TIMEOUT_S = 180.0
+FOLDCORE_CASE = "arc, graded W, H = 0.01a"
+HARNESS_PAGE = "foldcore_harness.html"
+#: what the page needs (a snapshot may lack its largest files, e.g. other demos)
+PAGE_FILES = ("index.html", "favicon.ico", "js", "css", "dependencies", "fonts",
+              "assets/Tessellations")
+
+HARNESS_JS = """
+(function () {
+  var STRAINS = %(strains)s, LIMIT_S = %(limit)s;
+  function post(result) {
+    var xhr = new XMLHttpRequest();
+    xhr.open("POST", "/result", true);
+    xhr.send(JSON.stringify(result));
+  }
+  window.addEventListener("error", function (e) {
+    post({error: String(e.message) + " at " + e.filename + ":" + e.lineno});
+  });
+  function built() {
+    return typeof globals !== "undefined" && globals.model && globals.model.getNodes &&
+      globals.model.getNodes().length > 0 && !globals.needsSync && !globals.simNeedsSync;
+  }
+  function creases() {
+    return globals.model.getCreases().map(function (c) {
+      return [c.edge.nodes[0].getIndex(), c.edge.nodes[1].getIndex(), c.node1.getIndex(),
+              c.node2.getIndex(), c.targetTheta, c.type];
+    });
+  }
+  function fold() {
+    globals.simulationRunning = false;  // the harness steps the solver itself
+    globals.model.reset();
+    globals.setCreasePercent(1.0);
+    globals.shouldChangeCreasePercent = true;
+    var steps = 0, log = [], reached = [], left = STRAINS.slice(), armed = false;
+    var t0 = performance.now();
+    function chunk() {
+      globals.model.step();
+      steps += globals.numSteps;
+      var t = (performance.now() - t0) / 1000;
+      var strain = parseFloat(document.getElementById("globalError").textContent);
+      log.push([steps, t, strain]);
+      armed = armed || strain >= STRAINS[0];  // past the start, when the sheet is still flat
+      while (armed && left.length && strain < left[0]) {
+        reached.push({strain_below: left.shift(), seconds: t, steps: steps, strain: strain,
+                      positions: Array.from(globals.model.getPositionsArray())});
+      }
+      if (left.length && t < LIMIT_S && isFinite(strain)) { setTimeout(chunk, 0); return; }
+      post({nodes: globals.model.getNodes().length, num_steps: globals.numSteps,
+            creases: creases(), log: log, reached: reached,
+            final_positions: Array.from(globals.model.getPositionsArray()),
+            original: globals.model.getNodes().map(function (n) {
+              var p = n.getOriginalPosition(); return [p.x, p.y, p.z]; }),
+            user_agent: navigator.userAgent});
+    }
+    setTimeout(chunk, 0);
+  }
+  (function wait() { if (built()) { setTimeout(fold, 200); } else { setTimeout(wait, 50); } })();
+})();
+"""
+
+
+def extract(source: Path, into: Path) -> str:
+    """Origami Simulator's files (``PAGE_FILES``) from ``source`` (bare git dir or
+    checkout) into ``into``; returns the commit (or "checkout")."""
+    if (source / "index.html").exists():
+        shutil.copytree(source, into, dirs_exist_ok=True)
+        return "checkout"
+    commit = subprocess.run(["git", "--git-dir", str(source), "rev-parse", "HEAD"],
+                            capture_output=True, text=True, check=True).stdout.strip()
+    archive = subprocess.run(["git", "--git-dir", str(source), "archive", "HEAD", *PAGE_FILES],
+                             capture_output=True, check=True).stdout
+    subprocess.run(["tar", "-x", "-C", str(into)], input=archive, check=True)
+    return commit
+
+
+def harness_page(root: Path) -> None:
+    """``HARNESS_PAGE`` in ``root``: index.html without the script it loads from
+    Google (its inline ``gtag`` stub, which the app calls, stays: it only queues),
+    the harness script after main.js."""
+    html = (root / "index.html").read_text()
+    start = html.index('<script async src="https://www.googletagmanager.com')
+    end = html.index("</script>", start) + len("</script>")
+    html = html[:start] + html[end:]
+    script = HARNESS_JS % {"strains": json.dumps(list(STRAINS)), "limit": OS_LIMIT_S}
+    anchor = '<script type="text/javascript" src="js/main.js"></script>'
+    if anchor not in html:
+        raise SystemExit("origami_simulator: index.html has no main.js script tag "
+                         "(another Origami Simulator version?)")
+    html = html.replace(anchor, anchor + "\n<script>" + script + "</script>")
+    (root / HARNESS_PAGE).write_text(html)
+
+
+class Server:
+    """Static files of ``root`` on 127.0.0.1; the harness's POST lands in ``results``."""
+
+    def __init__(self, root: Path):
+        results: queue.Queue = queue.Queue()
+
+        class Handler(http.server.SimpleHTTPRequestHandler):
+            def __init__(self, *args, **kwargs):
+                super().__init__(*args, directory=str(root), **kwargs)
+
+            def do_POST(self):  # noqa: N802 (http.server's name)
+                body = self.rfile.read(int(self.headers["Content-Length"]))
+                self.send_response(204)
+                self.end_headers()
+                results.put(json.loads(body))
+
+            def log_message(self, *args):
+                pass
+
+        self.results = results
+        self.httpd = http.server.ThreadingHTTPServer(("127.0.0.1", 0), Handler)
+        self.port = self.httpd.server_address[1]
+        threading.Thread(target=self.httpd.serve_forever, daemon=True).start()
+
+    def close(self) -> None:
+        self.httpd.shutdown()
+
+
+def crease_angle_errors(result: dict, positions) -> np.ndarray:
+    """(C,) |fold angle − |target|| in degrees of every M/V crease (type 1) at
+    ``positions`` (flat list, 3 per node), fold angle = angle between its two
+    triangles' normals (0 flat)."""
+    x = np.asarray(positions, dtype=float).reshape(-1, 3)
+    c = np.array([row for row in result["creases"] if row[5] == 1], dtype=float)
+    a, b, p, q = (x[c[:, k].astype(int)] for k in range(4))
+    d = b - a
+    n1, n2 = np.cross(d, p - a), np.cross(q - a, d)
+    angle = np.arctan2(np.linalg.norm(np.cross(n1, n2), axis=1), np.einsum("ij,ij->i", n1, n2))
+    return np.abs(np.degrees(angle) - np.degrees(np.abs(c[:, 4])))
+
+
+def run_origami_simulator(root: Path, profile: Path) -> dict:
+    """One Origami Simulator fold in a fresh Chromium (module docstring)."""
+    server = Server(root)
+    url = f"http://127.0.0.1:{server.port}/{HARNESS_PAGE}?model={MODEL}"
+    browser = subprocess.Popen([CHROMIUM, *FLAGS, f"--user-data-dir={profile}", url],
+                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        result = server.results.get(timeout=PAGE_TIMEOUT_S)
+    except queue.Empty:
+        raise SystemExit(f"origami_simulator: no result from the page in {PAGE_TIMEOUT_S:.0f} s")
+    finally:
+        browser.terminate()
+        browser.wait(timeout=30)
+        server.close()
+    if "error" in result:
+        raise SystemExit(f"origami_simulator: the page failed: {result['error']}")
+    for hit in result["reached"]:
+        errors = crease_angle_errors(result, hit.pop("positions"))
+        hit["max_angle_error_deg"] = float(errors.max())
+        hit["mean_angle_error_deg"] = float(errors.mean())
+    final = crease_angle_errors(result, result.pop("final_positions"))
+    result["final_max_angle_error_deg"] = float(final.max())
+    result["mv_creases"] = int(len(final))
+    for key in ("creases", "original"):
+        result.pop(key)
+    return result
+
+
+def foldcore_case():
+    """(pattern, mesh, kinds, options) of os_miura's graded flat row."""
+    import os_miura
+
+    (_, h, w, tilt, options), = [c for c in os_miura.CASES if c[0] == FOLDCORE_CASE]
+    pattern, mesh, kinds = os_miura.build(h, w, tilt, options)
+    return pattern, mesh, kinds, options
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--origami-simulator", type=Path, default=None,
+                        help="Origami Simulator: a bare git dir or a checkout "
+                             f"(default {DEFAULT_SOURCE}; skipped when absent)")
+    parser.add_argument("--rounds", type=int, default=ROUNDS)
+    args = parser.parse_args()
+    source = args.origami_simulator or DEFAULT_SOURCE
+    missing = [f"{p} not found" for p in (source, Path(CHROMIUM)) if not p.exists()]
+    if missing and args.origami_simulator is None:  # e.g. under bench/run.py: not an error
+        print(f"origami_simulator: skipped ({'; '.join(missing)}: give "
+              "--origami-simulator, a checkout or bare git dir of "
+              "github.com/amandaghassaei/OrigamiSimulator; make test installs Chromium)")
+        return
+    if missing:
+        sys.exit(f"origami_simulator: {'; '.join(missing)}")
+    import os_miura
+    from scaling import others_busy
+
+    pattern, mesh, kinds, options = foldcore_case()
+    os_miura.fold_once(pattern, mesh, kinds, options)  # warm-up
+    rounds = []
+    with tempfile.TemporaryDirectory() as tmp:
+        root = Path(tmp) / "OrigamiSimulator"
+        root.mkdir()
+        commit = extract(source, root)
+        harness_page(root)
+        for k in range(args.rounds):
+            busy_os = others_busy(1.0)
+            simulator = run_origami_simulator(root, Path(tmp) / f"profile{k}")
+            busy_fc = others_busy(1.0)
+            ours = os_miura.fold_once(pattern, mesh, kinds, options)
+            first = simulator["reached"][0]["seconds"] if simulator["reached"] else None
+            rounds.append({"origami_simulator": simulator, "foldcore": ours,
+                           "others_busy": {"origami_simulator": busy_os, "foldcore": busy_fc},
+                           "ratio_first_strain": first / ours["seconds"] if first else None})
+            reached = ", ".join(f"< {h['strain_below']:g} %: {h['seconds']:.2f} s "
+                                f"({h['steps']} steps, max angle error "
+                                f"{h['max_angle_error_deg']:.3g}°)"
+                                for h in simulator["reached"])
+            print(f"round {k}: Origami Simulator {reached or 'no threshold reached'}; "
+                  f"foldcore {ours['seconds']:.3f} s, {ours['iterations']} iterations, "
+                  f"straight miss {ours['straight_miss_deg']:.2g}° (busy {busy_os:.2f}, "
+                  f"{busy_fc:.2f})", flush=True)
+    out = {"meta": {**machine_meta(), "date": time.strftime("%Y-%m-%d"),
+                    "origami_simulator_commit": commit, "model": MODEL, "strains_percent":
+                    list(STRAINS), "foldcore_case": FOLDCORE_CASE, "rounds": args.rounds,
+                    "chromium_flags": FLAGS},
+           "rounds": rounds}
+    RESULTS.mkdir(exist_ok=True)
+    path = RESULTS / "origami_simulator.json"
+    path.write_text(json.dumps(out, indent=1))
+    plot(out, path.with_suffix(".png"))
+    print(table(out))
+
+
+def summary(out: dict) -> dict:
+    """Medians over the rounds: Origami Simulator's seconds and max angle error per
+    threshold, foldcore's seconds, and the per-round ratios."""
+    rounds = out["rounds"]
+    per = {}
+    for level in out["meta"]["strains_percent"]:
+        hits = [h for r in rounds for h in r["origami_simulator"]["reached"]
+                if h["strain_below"] == level]
+        if len(hits) == len(rounds):
+            per[level] = {"seconds": float(np.median([h["seconds"] for h in hits])),
+                          "steps": int(np.median([h["steps"] for h in hits])),
+                          "max_angle_error_deg": float(np.median([h["max_angle_error_deg"]
+                                                                  for h in hits])),
+                          "ratios": [h["seconds"] / r["foldcore"]["seconds"]
+                                     for h, r in zip(hits, rounds)]}
+    ours = [r["foldcore"] for r in rounds]
+    return {"origami_simulator": per,
+            "foldcore_seconds": float(np.median([o["seconds"] for o in ours])),
+            "foldcore_straight_miss_deg": max(o["straight_miss_deg"] for o in ours),
+            "foldcore_iterations": [o["iterations"] for o in ours]}
+
+
+def table(out: dict) -> str:
+    s = summary(out)
+    rows = [[f"Origami Simulator, mean strain < {level:g} %", f"{v['seconds']:.2f}",
+             f"{v['steps']} steps", f"{v['max_angle_error_deg']:.3g}",
+             " / ".join(f"{r:.1f}" for r in v["ratios"])]
+            for level, v in s["origami_simulator"].items()]
+    rows.append(["foldcore (thick, graded arc hinges, tolerance 1e-9)",
+                 f"{s['foldcore_seconds']:.2f}",
+                 " / ".join(map(str, s["foldcore_iterations"])) + " iterations",
+                 f"{s['foldcore_straight_miss_deg']:.2g}", "1"])
+    return markdown_table(["run", "s (median)", "work", "max crease miss (°)",
+                           "× foldcore's time, per round"], rows)
+
+
+def plot(out: dict, path: Path) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(7, 4.2))
+    for k, r in enumerate(out["rounds"]):
+        log = np.array(r["origami_simulator"]["log"])
+        ax.semilogy(log[:, 1], log[:, 2], color="C0", alpha=0.7,
+                    label="Origami Simulator (mean node strain)" if k == 0 else None)
+        ax.axvline(r["foldcore"]["seconds"], color="C3", ls="--",
+                   label="foldcore: converged fold (tolerance 1e-9)" if k == 0 else None)
+    for level in out["meta"]["strains_percent"]:
+        ax.axhline(level, color="0.6", ls=":", lw=1)
+    ax.set_xlabel("seconds (this host, one run per round, interleaved)")
+    ax.set_ylabel("mean strain, %")
+    ax.set_title("Origami Simulator's miura-ori.svg folded flat", fontsize=9)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+
+
+if __name__ == "__main__":
+    if len(sys.argv) > 1 and sys.argv[1] == "--table":
+        print(table(json.loads((RESULTS / "origami_simulator.json").read_text())))
+    else:
+        main()
