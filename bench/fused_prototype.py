@@ -108,7 +108,7 @@ class Fused:
     """The fused iteration's data: per group, its elements split by colour."""
 
     def __init__(self, sim, cached: bool):
-        from elements.bending_hinge import shapes as hinge_shapes
+        from elements.bending_hinge import bent_shapes
 
         runs = sim._runs
         self.sim = sim
@@ -126,9 +126,8 @@ class Fused:
             g = r.group
             if cached and r.etype.name == "bending_hinge":
                 assert not np.isnan(r.params[:, 2]).any(), "every strip actuated here"
-                d_out = np.empty_like(g.rest)
                 out = np.empty_like(g.rest)
-                hinge_shapes(g.indptr, g.rest, r.params, r.params[:, 2], out, d_out)
+                bent_shapes(g.indptr, g.rest, r.params, r.params[:, 2], out)
                 self.shapes.append(out)
             elif cached and r.etype.name == "rigid_panel":
                 self.shapes.append(np.ascontiguousarray(g.rest))
