@@ -838,7 +838,7 @@ def _hinge_group(pattern, points, strip_points, widths, ks, thickness, hinges, s
     on Miura 50 × 50)."""
     n_top = len(points)
     creases = list(strip_points)
-    quads, lengths, strips_of, count = [], [], {}, 0
+    quads, series, lengths, strips_of, count = [], [], [], {}, 0
     for e in creases:
         k = int(ks[e])
         grid = np.asarray(strip_points[e], dtype=np.int64)  # (k + 1, m + 1): line j, point t
@@ -848,6 +848,7 @@ def _hinge_group(pattern, points, strip_points, widths, ks, thickness, hinges, s
         # segment-major: each segment's k strips left → right
         quads.append(np.stack([grid[:-1, :-1].T, grid[1:, :-1].T, grid[1:, 1:].T,
                                grid[:-1, 1:].T], axis=-1).reshape(k * m, 4))
+        series.append(np.arange(k * m) % k)  # each strip's place in its series
         # per segment, as before: a vectorised norm sums differently (not bit-identical)
         lengths.append([_length(points[b] - points[a])
                         for a, b in zip(grid[0, :-1], grid[0, 1:])])
@@ -864,9 +865,7 @@ def _hinge_group(pattern, points, strip_points, widths, ks, thickness, hinges, s
     src = np.repeat(e_arr, per_crease)
     params = np.repeat(_hinge_params(pattern, e_arr, widths, k_arr, thickness, hinges), per_crease,
                        axis=0)
-    params[:, HINGE_PARAMS.index("series")] = \
-        np.arange(len(src)) - np.repeat(np.cumsum(per_crease) - per_crease, per_crease)
-    params[:, HINGE_PARAMS.index("series")] %= np.repeat(k_arr, per_crease)  # place in its series
+    params[:, HINGE_PARAMS.index("series")] = np.concatenate(series)
     vols = np.concatenate([np.repeat(widths[e] / ks[e] * np.array(length) * thickness, ks[e])
                            for e, length in zip(creases, lengths)])
     stiff_e = np.broadcast_to(np.asarray(stiffness, dtype=float), (pattern.n_edges,))
