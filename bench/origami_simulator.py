@@ -45,7 +45,6 @@ from __future__ import annotations
 import argparse
 import http.server
 import json
-import os
 import queue
 import shutil
 import subprocess
