@@ -1,7 +1,8 @@
 # Set-up, main job and tests of foldcore on a fresh Debian machine.
 #   make demo    fold the built-in scenes, write FOLD + PNG + JSON to out/
 #   make test    run the test suite
-#   make bench   run the benchmarks (results in bench/results/)
+#   make bench   run the benchmarks (results in bench/results/; installs the
+#                bench extra, PyAMG, first)
 # Both demo and test do all set-up first: system library for CHOLMOD (when
 # root), a virtual environment in .venv, the package with its extras, and the
 # default path's numba kernels compiled once (foldcore.warmup), so the first
@@ -39,6 +40,7 @@ test: setup
 	$(PY) -m pytest -q
 
 bench: setup
+	$(PY) -m pip install --quiet -e ".[bench]"
 	$(PY) bench/run.py
 
 clean:
