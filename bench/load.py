@@ -15,8 +15,20 @@ Target: no case ≥ 10× its quiet median.
 
 Cases: ``paper`` Miura 4 × 4 (serial by size), ``lbfgs`` Miura 10 × 10 with
 ``threads=1`` and with the default (2) threads, ``paper`` Miura 20 × 20
-(2 threads). Run: ``.venv/bin/python bench/load.py`` (~3 min). Writes
-bench/results/load.json and .png.
+(2 threads). Beside each, a control: a serial pure-Python loop (no numba,
+no BLAS, no threads) calibrated to that case's quiet median step time and
+timed in the same rounds. Its loaded / quiet ratios are what the operating
+system's scheduler alone does to a task of that length when more processes
+are runnable than there are cores — the floor any step of that length
+reaches, whatever its thread layer.
+
+The whole measurement runs in child processes, alternating REPEATS times
+between OpenMP wait policies (POLICIES): ``PASSIVE``, which ``import
+foldcore`` sets unless the user set the variable, and GNU OpenMP's default
+(threads spin before they sleep), so the gain of the setting is measured in
+one run. Each policy's times are merged over its children. Run:
+``.venv/bin/python bench/load.py`` (~1.5 min). Writes bench/results/load.json
+and .png.
 """
 from __future__ import annotations
 
@@ -33,7 +45,11 @@ sys.path.insert(0, str(Path(__file__).parent))
 from _meta import machine_meta  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
-WARMUP, STEPS, ROUNDS = 20, 150, 3
+WARMUP, STEPS, ROUNDS, REPEATS = 20, 150, 3, 2
+# OpenMP wait policies compared, each in its own child processes (libgomp
+# reads the variable once, when it loads): foldcore's default, and GNU
+# OpenMP's own (threads spin ~300 000 polls before they sleep)
+POLICIES = {"passive (foldcore's default)": "PASSIVE", "GNU OpenMP's default": "default"}
 COMPETITORS = os.cpu_count() or 2
 CASES = {"paper, Miura 4x4": ("paper", 4, None), "lbfgs, Miura 10x10, threads=1":
          ("lbfgs", 10, 1), "lbfgs, Miura 10x10, default threads": ("lbfgs", 10, None),
@@ -59,14 +75,49 @@ def step_times(sim) -> list:
     return out
 
 
+def serial_work(count: int) -> int:
+    """A pure-Python loop: one thread, no numba, no BLAS; ``count`` sets its length."""
+    total = 0
+    for i in range(count):
+        total += i * i
+    return total
+
+
+def calibrated_count(target_s: float) -> int:
+    """Loop count of ``serial_work`` whose median time (quiet) is ``target_s`` seconds."""
+    count = 1000
+    for _ in range(3):
+        times = []
+        for _ in range(31):
+            start = time.perf_counter()
+            serial_work(count)
+            times.append(time.perf_counter() - start)
+        count = max(1, int(round(count * target_s / float(np.median(times)))))
+    return count
+
+
+def control_times(count: int) -> list:
+    out = []
+    for _ in range(STEPS):
+        start = time.perf_counter()
+        serial_work(count)
+        out.append(time.perf_counter() - start)
+    return out
+
+
 def competitors() -> list:
     return [subprocess.Popen([sys.executable, "-c", "while True: pass"])
             for _ in range(COMPETITORS)]
 
 
-def main() -> None:
+def measure() -> dict:
+    """Raw step and control times (s) per case and condition, ROUNDS alternating
+    quiet / loaded rounds in this process; and the load averages between them."""
     sims = {name: simulation(*case) for name, case in CASES.items()}
-    times = {name: {"quiet": [], "loaded": []} for name in CASES}
+    counts = {name: calibrated_count(float(np.median(step_times(sim))))
+              for name, sim in sims.items()}
+    controls = {f"control for {name}": count for name, count in counts.items()}
+    times = {name: {"quiet": [], "loaded": []} for name in (*CASES, *controls)}
     load = [os.getloadavg()]
     for _ in range(ROUNDS):
         for condition in ("quiet", "loaded"):
@@ -75,57 +126,125 @@ def main() -> None:
                 time.sleep(0.5 if busy else 0.0)  # let the competitors take the cores
                 for name, sim in sims.items():
                     times[name][condition] += step_times(sim)
+                    control = f"control for {name}"
+                    times[control][condition] += control_times(controls[control])
             finally:
                 for p in busy:
                     p.kill()
                     p.wait()
             load.append(os.getloadavg())
-    rows = {}
-    for name, t in times.items():
-        q, b = np.array(t["quiet"]), np.array(t["loaded"])
-        rows[name] = {"threads": sims[name].threads,
-                      "quiet_median_ms": 1e3 * float(np.median(q)),
-                      "quiet_p95_ms": 1e3 * float(np.percentile(q, 95)),
-                      "loaded_median_ms": 1e3 * float(np.median(b)),
-                      "loaded_p95_ms": 1e3 * float(np.percentile(b, 95)),
-                      "quiet_max_ms": 1e3 * float(q.max()),
-                      "loaded_max_ms": 1e3 * float(b.max()),
-                      "loaded_p99_ms": 1e3 * float(np.percentile(b, 99)),
-                      "median_ratio": float(np.median(b) / np.median(q)),
-                      "p95_ratio": float(np.percentile(b, 95) / np.median(q)),
-                      "p99_ratio": float(np.percentile(b, 99) / np.median(q)),
-                      "max_ratio": float(b.max() / np.median(q))}
-        print(f"{name:40s} threads {rows[name]['threads']}  quiet {rows[name]['quiet_median_ms']:.3f}"
-              f" ms (p95 {rows[name]['quiet_p95_ms']:.3f})  loaded {rows[name]['loaded_median_ms']:.3f}"
-              f" ms (p95 {rows[name]['loaded_p95_ms']:.3f})  ratio {rows[name]['median_ratio']:.2f}"
-              f" / p95 {rows[name]['p95_ratio']:.2f} / p99 {rows[name]['p99_ratio']:.1f}"
-              f" / max {rows[name]['max_ratio']:.0f}", flush=True)
-    out = {"cases": rows, "steps_per_round": STEPS, "rounds": ROUNDS,
-           "competitors": COMPETITORS, "load": load, "machine": machine_meta()}
+    return {"times": times, "load": load, "threads": {n: s.threads for n, s in sims.items()},
+            "loop_counts": controls}
+
+
+def child(policy: str, out: Path) -> None:
+    """One measurement with OpenMP's wait policy ``policy`` ("default": GNU
+    OpenMP's own, i.e. unset after ``import foldcore`` set it and before
+    anything loaded libgomp)."""
+    import foldcore  # noqa: F401  (sets OMP_WAIT_POLICY unless the user did)
+
+    if policy == "default":
+        os.environ.pop("OMP_WAIT_POLICY", None)
+    else:
+        os.environ["OMP_WAIT_POLICY"] = policy
+    out.write_text(json.dumps(measure()))
+
+
+def summary(t: dict) -> dict:
+    """Medians, percentiles (ms) and loaded / quiet ratios of one case's times."""
+    q, b = np.array(t["quiet"]), np.array(t["loaded"])
+    return {"quiet_median_ms": 1e3 * float(np.median(q)),
+            "quiet_p95_ms": 1e3 * float(np.percentile(q, 95)),
+            "loaded_median_ms": 1e3 * float(np.median(b)),
+            "loaded_p95_ms": 1e3 * float(np.percentile(b, 95)),
+            "quiet_max_ms": 1e3 * float(q.max()),
+            "loaded_max_ms": 1e3 * float(b.max()),
+            "loaded_p99_ms": 1e3 * float(np.percentile(b, 99)),
+            "median_ratio": float(np.median(b) / np.median(q)),
+            "p95_ratio": float(np.percentile(b, 95) / np.median(q)),
+            "p99_ratio": float(np.percentile(b, 99) / np.median(q)),
+            "max_ratio": float(b.max() / np.median(q)),
+            "steps": {"quiet": int(q.size), "loaded": int(b.size)}}
+
+
+def main() -> None:
+    """Alternate child processes over POLICIES REPEATS times; merge each policy's times."""
+    merged = {policy: {} for policy in POLICIES}
+    meta = {policy: {"load": [], "threads": {}, "loop_counts": []} for policy in POLICIES}
+    scratch = ROOT / "bench" / "results" / ".load-child.json"
+    try:
+        for _ in range(REPEATS):
+            for policy, value in POLICIES.items():
+                subprocess.run([sys.executable, __file__, "--child", value, str(scratch)],
+                               check=True)
+                run = json.loads(scratch.read_text())
+                for name, t in run["times"].items():
+                    slot = merged[policy].setdefault(name, {"quiet": [], "loaded": []})
+                    slot["quiet"] += t["quiet"]
+                    slot["loaded"] += t["loaded"]
+                meta[policy]["load"] += run["load"]
+                meta[policy]["threads"] = run["threads"]
+                meta[policy]["loop_counts"].append(run["loop_counts"])
+    finally:
+        scratch.unlink(missing_ok=True)
+    out = {"policies": {}, "steps_per_round": STEPS, "rounds_per_child": ROUNDS,
+           "children_per_policy": REPEATS, "competitors": COMPETITORS,
+           "machine": machine_meta()}
+    for policy, times in merged.items():
+        rows = {name: {"threads": meta[policy]["threads"].get(name, 1), **summary(t)}
+                for name, t in times.items()}
+        out["policies"][policy] = {"OMP_WAIT_POLICY": POLICIES[policy], "cases": rows,
+                                   "load": meta[policy]["load"],
+                                   "loop_counts": meta[policy]["loop_counts"]}
+        print(f"-- OpenMP wait policy: {policy}")
+        for name, r in rows.items():
+            print(f"{name:48s} threads {r['threads']}  quiet {r['quiet_median_ms']:.3f} ms"
+                  f" (p95 {r['quiet_p95_ms']:.3f})  loaded {r['loaded_median_ms']:.3f} ms"
+                  f" (p95 {r['loaded_p95_ms']:.3f})  ratio {r['median_ratio']:.2f}"
+                  f" / p95 {r['p95_ratio']:.2f} / p99 {r['p99_ratio']:.1f}"
+                  f" / max {r['max_ratio']:.0f}", flush=True)
     results = ROOT / "bench" / "results"
     (results / "load.json").write_text(json.dumps(out, indent=1))
-    plot(rows, results / "load.png")
+    plot(out["policies"], results / "load.png")
 
 
-def plot(rows: dict, path: Path) -> None:
+def plot(policies: dict, path: Path) -> None:
+    """Per wait policy (one panel each) and case, loaded / quiet ratios of the step
+    (solid) and of its serial control (hatched)."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    names = list(rows)
-    x = np.arange(len(names))
-    fig, ax = plt.subplots(figsize=(8, 4))
-    for i, (key, label) in enumerate((("median_ratio", "median"), ("p95_ratio", "95th pct"))):
-        ax.bar(x + (i - 0.5) * 0.35, [rows[n][key] for n in names], 0.35, label=label)
-    ax.axhline(10, color="red", lw=1, ls="--", label="target: < 10×")
-    ax.set_xticks(x, [n.replace(", ", "\n") for n in names], fontsize=8)
-    ax.set_ylabel("loaded / quiet median step time")
-    ax.set_yscale("log")
-    ax.legend()
-    ax.set_title(f"step time with {COMPETITORS} CPU-bound competitors")
+    stats = (("median_ratio", "median"), ("p95_ratio", "95th pct"),
+             ("p99_ratio", "99th pct"), ("max_ratio", "max"))
+    width = 0.1
+    fig, axes = plt.subplots(1, len(policies), figsize=(14, 4.8), sharey=True)
+    for ax, (policy, entry) in zip(np.atleast_1d(axes), policies.items()):
+        rows = entry["cases"]
+        cases = [n for n in rows if not n.startswith("control for ")]
+        x = np.arange(len(cases))
+        for i, (key, label) in enumerate(stats):
+            colour = f"C{i}"
+            offset = (2 * i - 3.5) * width
+            ax.bar(x + offset, [rows[n][key] for n in cases], width, color=colour,
+                   label=f"{label}, step")
+            ax.bar(x + offset + width, [rows[f"control for {n}"][key] for n in cases], width,
+                   color="white", edgecolor=colour, hatch="///",
+                   label=f"{label}, serial Python control")
+        ax.axhline(10, color="red", lw=1, ls="--", label="target: < 10×")
+        ax.set_xticks(x, [n.replace(", ", "\n") for n in cases], fontsize=8)
+        ax.set_yscale("log")
+        ax.set_title(f"OpenMP wait policy: {policy}", fontsize=10)
+    np.atleast_1d(axes)[0].set_ylabel("loaded / quiet median time")
+    np.atleast_1d(axes)[0].legend(fontsize=7, ncol=2)
+    fig.suptitle(f"step time with {COMPETITORS} CPU-bound competitors, beside a serial"
+                 " loop of the same quiet length")
     fig.tight_layout()
     fig.savefig(path, dpi=100)
 
 
 if __name__ == "__main__":
-    main()
+    if sys.argv[1:2] == ["--child"]:
+        child(sys.argv[2], Path(sys.argv[3]))
+    else:
+        main()

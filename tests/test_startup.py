@@ -90,3 +90,36 @@ def test_public_names_survive_submodule_imports():
         importlib.import_module(f"foldcore.{info.name}")
     assert callable(foldcore.thicken) and callable(foldcore.read)
     assert isinstance(foldcore.Simulation, type)
+
+
+WAIT_POLICY_PROBE = """
+import ctypes, json
+import foldcore
+gomp_before = any("libgomp" in line for line in open("/proc/self/maps"))
+from foldcore import Simulation, patterns, thicken
+p = patterns.miura_one_crease(4, 4, a=20.0, b=20.0, width=0.6)
+Simulation(thicken(p, 0.2), p, solver="paper", threads=2).run(max_iterations=3)
+ctypes.CDLL("libgomp.so.1").omp_display_env(1)    # verbose, to the process's stderr
+print(json.dumps({"gomp_before": gomp_before}))
+"""
+
+
+def _gomp_spin_count(env: dict) -> tuple:
+    """(libgomp loaded by ``import foldcore``?, the spin count libgomp runs with)."""
+    proc = subprocess.run([sys.executable, "-c", WAIT_POLICY_PROBE], capture_output=True,
+                          text=True, timeout=600, check=True, env=env)
+    spins = [int(line.split("=", 1)[1].strip().strip("'")) for line in proc.stderr.splitlines()
+             if line.strip().startswith("GOMP_SPINCOUNT")]
+    return json.loads(proc.stdout.strip().splitlines()[-1])["gomp_before"], spins
+
+
+def test_openmp_threads_wait_passively_unless_the_user_chose():
+    """``import foldcore`` sets OMP_WAIT_POLICY=PASSIVE before anything loads GNU
+    OpenMP, and the libgomp a simulation runs on took it: its own report shows
+    no spinning (GOMP_SPINCOUNT 0; unset, 300 000 polls). A value the user set
+    is kept (ACTIVE: far more). Why: issue 17, ``bench/load.py``."""
+    env = {k: v for k, v in os.environ.items()
+           if k not in ("OMP_WAIT_POLICY", "GOMP_SPINCOUNT")}
+    assert _gomp_spin_count(env) == (False, [0])
+    loaded_before, spins = _gomp_spin_count({**env, "OMP_WAIT_POLICY": "ACTIVE"})
+    assert not loaded_before and spins and spins[0] > 300_000

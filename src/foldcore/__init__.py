@@ -16,7 +16,15 @@ Data flow: pattern → thick mesh → system → simulation → result → outpu
 Units: mm and degrees at every public API. Submodules are imported lazily so
 that ``import foldcore`` is fast and never imports numba kernels or pyvista.
 """
+import os
 from importlib import import_module
+
+# Before anything loads GNU OpenMP (numba's "omp" threading layer, CHOLMOD
+# through scikit-sparse): idle OpenMP threads sleep instead of spinning, so a
+# parallel step on a shared machine does not wait a time slice for a thread a
+# spinning sibling displaced (issue 17, bench/load.py; see foldcore.threads).
+# A value the user set is kept; libgomp reads it once, when it loads.
+os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
 
 from .errors import (FoldcoreError, KernelCacheWarning, MeshError, PatternError, PatternWarning,
                      RunWarning, SimulationError)
