@@ -4,8 +4,8 @@ Per case, the time of single strategy steps (``Simulation.step``; warm numba
 cache, STEPS timed after WARMUP), measured quiet and with COMPETITORS
 CPU-bound processes (``while True: pass``) sharing the machine's cores; the
 rounds alternate quiet / loaded ROUNDS times, so a change of the machine's
-own load hits both. Reported per case and condition: median and 95th
-percentile step time, and loaded / quiet ratios. With every core taken by a
+own load hits both. Reported per case and condition: median, 95th and 99th
+percentile and largest step time, and their ratios to the quiet median. With every core taken by a
 competitor, a step that computes should cost about (competitors + 1) / cores
 of its quiet time; one that waits on spinning or yielding threads (numba's
 parallel loops, OpenBLAS's threads) can cost far more — the issue measured
@@ -37,6 +37,7 @@ import os
 import subprocess
 import sys
 import time
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -66,11 +67,12 @@ def simulation(solver: str, n: int, threads):
     return sim
 
 
-def step_times(sim) -> list:
+def run_times(work, runs: int) -> list:
+    """Wall times (s) of ``runs`` calls of ``work()``, one by one."""
     out = []
-    for _ in range(STEPS):
+    for _ in range(runs):
         start = time.perf_counter()
-        sim.step()
+        work()
         out.append(time.perf_counter() - start)
     return out
 
@@ -87,22 +89,9 @@ def calibrated_count(target_s: float) -> int:
     """Loop count of ``serial_work`` whose median time (quiet) is ``target_s`` seconds."""
     count = 1000
     for _ in range(3):
-        times = []
-        for _ in range(31):
-            start = time.perf_counter()
-            serial_work(count)
-            times.append(time.perf_counter() - start)
+        times = run_times(partial(serial_work, count), 31)
         count = max(1, int(round(count * target_s / float(np.median(times)))))
     return count
-
-
-def control_times(count: int) -> list:
-    out = []
-    for _ in range(STEPS):
-        start = time.perf_counter()
-        serial_work(count)
-        out.append(time.perf_counter() - start)
-    return out
 
 
 def competitors() -> list:
@@ -114,7 +103,7 @@ def measure() -> dict:
     """Raw step and control times (s) per case and condition, ROUNDS alternating
     quiet / loaded rounds in this process; and the load averages between them."""
     sims = {name: simulation(*case) for name, case in CASES.items()}
-    counts = {name: calibrated_count(float(np.median(step_times(sim))))
+    counts = {name: calibrated_count(float(np.median(run_times(sim.step, STEPS))))
               for name, sim in sims.items()}
     controls = {f"control for {name}": count for name, count in counts.items()}
     times = {name: {"quiet": [], "loaded": []} for name in (*CASES, *controls)}
@@ -125,9 +114,10 @@ def measure() -> dict:
             try:
                 time.sleep(0.5 if busy else 0.0)  # let the competitors take the cores
                 for name, sim in sims.items():
-                    times[name][condition] += step_times(sim)
+                    times[name][condition] += run_times(sim.step, STEPS)
                     control = f"control for {name}"
-                    times[control][condition] += control_times(controls[control])
+                    work = partial(serial_work, controls[control])
+                    times[control][condition] += run_times(work, STEPS)
             finally:
                 for p in busy:
                     p.kill()

@@ -34,10 +34,17 @@ print(json.dumps(misses))
 """
 
 
-def _probe(code: str, env=None) -> dict:
-    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+def _run(code: str, env=None) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                           timeout=600, check=True, env=env)
+
+
+def _last_json(proc: subprocess.CompletedProcess) -> dict:
     return json.loads(proc.stdout.strip().splitlines()[-1])
+
+
+def _probe(code: str, env=None) -> dict:
+    return _last_json(_run(code, env))
 
 
 def test_import_is_fast_and_imports_no_heavy_module():
@@ -106,11 +113,10 @@ print(json.dumps({"gomp_before": gomp_before}))
 
 def _gomp_spin_count(env: dict) -> tuple:
     """(libgomp loaded by ``import foldcore``?, the spin count libgomp runs with)."""
-    proc = subprocess.run([sys.executable, "-c", WAIT_POLICY_PROBE], capture_output=True,
-                          text=True, timeout=600, check=True, env=env)
+    proc = _run(WAIT_POLICY_PROBE, env)
     spins = [int(line.split("=", 1)[1].strip().strip("'")) for line in proc.stderr.splitlines()
              if line.strip().startswith("GOMP_SPINCOUNT")]
-    return json.loads(proc.stdout.strip().splitlines()[-1])["gomp_before"], spins
+    return _last_json(proc)["gomp_before"], spins
 
 
 def test_openmp_threads_wait_passively_unless_the_user_chose():

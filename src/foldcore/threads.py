@@ -23,9 +23,9 @@ competitors on 2 cores (``bench/load.py``, 2026-12-06, AMD EPYC guest), the
 99th percentile of a 2-thread L-BFGS step of Miura 10 × 10 was 39 × its
 quiet median and of a paper step of Miura 20 × 20 29 ×. ``import foldcore``
 therefore sets ``OMP_WAIT_POLICY=PASSIVE`` (idle threads sleep at once)
-unless the user set it: then 6.4 × and 4.5 ×, what a serial pure-Python loop of the same length
-measured beside them (6.1 ×, 3.2 ×); quiet steps cost the same within the
-noise. libgomp reads the variable once, when it loads; so it takes effect
+unless the user set it: then 6.4 × and 4.5 ×, what a serial pure-Python
+loop of the same length measured beside them (6.1 ×, 3.2 ×); quiet steps
+cost the same within the noise. libgomp reads the variable once, when it loads; so it takes effect
 only if no OpenMP code was loaded before ``import foldcore``, and it is
 inherited by child processes.
 """
