@@ -1,14 +1,15 @@
-"""The rigid-body strategy's coarse start (foldcore.coarse): a run from rest steps
-the one-strip twin first, then the mesh's own engine from the twin's state."""
+"""The rigid-body strategy's coarse start (strategies/rigid/twin.py): a run from rest
+steps the one-strip twin first, then the mesh's own engine from the twin's state."""
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-import foldcore.strategies.rigid as rigid_strategy
 from foldcore import patterns, thicken
-from foldcore.coarse import Twin, twin_mesh
 from foldcore.simulation import Simulation
+from foldcore.strategies.hybrid import HybridOptions
+from foldcore.strategies.rigid import RigidOptions
+from foldcore.strategies.rigid.twin import hand_over, twin_mesh
 
 TOL = 1e-8
 
@@ -29,10 +30,16 @@ def phase(sim) -> str:
     return "coarse" if rigid is not None and rigid.twin is not None else sim.strategy.phase
 
 
-def fold(pattern, mesh, coarse: bool, monkeypatch, **run):
-    monkeypatch.setattr(rigid_strategy, "COARSE_START", coarse)
+def simulation(mesh, pattern, coarse: bool, solver: str = "hybrid"):
+    """A simulation whose rigid phase starts on the coarse twin or not."""
+    rigid = RigidOptions(coarse_start=coarse)
+    options = rigid if solver == "rigid" else HybridOptions(rigid=rigid)
+    return Simulation(mesh, pattern, solver=solver, options=options)
+
+
+def fold(pattern, mesh, coarse: bool, **run):
     phases = []
-    sim = Simulation(mesh, pattern)
+    sim = simulation(mesh, pattern, coarse)
     result = sim.run(tolerance=TOL, callback=lambda s, moved: phases.append(phase(s)), **run)
     return sim, result, phases
 
@@ -52,82 +59,77 @@ def test_the_twin_has_one_strip_per_crease_and_the_same_panels():
     assert twin_mesh(twin, pattern) is None  # already one strip wide: no twin of its own
 
 
-def test_a_fold_from_rest_steps_the_twin_and_ends_where_the_mesh_agrees(monkeypatch):
+def test_a_fold_from_rest_steps_the_twin_and_ends_where_the_mesh_agrees():
     """Axis hinges: the twin's equilibrium is the mesh's, so the hand-over leaves every
     strip of the mesh on its bent shape (within the run's limit) and the run ends
     there, with no step of the mesh's own engine (no factorisation of its much
     larger normal matrix)."""
     pattern, mesh, expected, creases = miura()
-    sim, result, phases = fold(pattern, mesh, True, monkeypatch)
+    sim, result, phases = fold(pattern, mesh, True)
     assert result.converged
     assert phases[0] == "coarse" and "rigid" not in phases
-    engine = sim.strategy._engine.engine
-    assert engine._normal_factor is None  # the mesh's engine never stepped
+    engine = sim.strategy.rigid_phase.engine
+    assert engine.lm.factor is None  # the mesh's engine never stepped
     size = float(np.ptp(pattern.vertices, axis=0).max())
-    residual = engine._residual(engine.x, engine.rot_e) / engine.sqrt_w[:, None, None]
+    residual = engine.residual.strip_rows(engine.x, engine.rot_e) \
+        / engine.residual.sqrt_w[:, None, None]
     assert np.abs(residual).max() <= TOL * size
     # both models meet the closed form; 1e-6° is far above the tolerance's 1e-8 × size
     assert np.abs(result.fold_angles_deg[creases] - expected).max() < 1e-6
     # the positions are the mesh engine's, hinge interiors included (not the rest state)
-    assert np.array_equal(sim.x, sim.strategy._engine.engine.x)
+    assert np.array_equal(sim.x, sim.strategy.rigid_phase.engine.x)
     assert np.abs(sim.x - mesh.rest_positions).max() > 1.0
 
 
-def test_the_coarse_start_lands_where_the_mesh_alone_lands(monkeypatch):
+def test_the_coarse_start_lands_where_the_mesh_alone_lands():
     pattern, mesh, _, _ = miura()
-    alone, a, phases = fold(pattern, mesh, False, monkeypatch)
+    alone, a, phases = fold(pattern, mesh, False)
     assert "coarse" not in phases
-    coarse, b, _ = fold(pattern, mesh, True, monkeypatch)
+    coarse, b, _ = fold(pattern, mesh, True)
     size = float(np.ptp(pattern.vertices, axis=0).max())
     # two runs settled within TOL × size of one equilibrium: a few times that apart
     assert np.abs(a.positions - b.positions).max() < 100 * TOL * size
     assert np.nanmax(np.abs(a.fold_angles_deg - b.fold_angles_deg)) < 1e-5
 
 
-def test_handing_over_places_the_hinge_interiors_on_their_strips(monkeypatch):
+def test_handing_over_places_the_hinge_interiors_on_their_strips():
     """After the twin's fold the mesh's strips are unstrained: the placed interiors
     (chained strip by strip from a panel) close on the far panel."""
-    monkeypatch.setattr(rigid_strategy, "COARSE_START", False)
     pattern, mesh, _, _ = miura(3)
-    fine = Simulation(mesh, pattern, solver="rigid")
-    twin = Twin(fine, twin_mesh(mesh, pattern))
-    twin.mirror(fine)
-    assert twin.sim.run(tolerance=1e-10).converged
+    fine = simulation(mesh, pattern, False, solver="rigid")
+    twin = Simulation(twin_mesh(mesh, pattern), pattern, solver="rigid", branch_floor_deg=0.0,
+                      options=RigidOptions(coarse_start=False))
+    assert twin.run(tolerance=1e-10).converged
     engine = fine.strategy.engine
-    twin.hand_over(engine)
-    engine._update_shapes(engine.phi)
-    from foldcore import rigid_normal
-
-    rigid_normal.fit_strip_rotations(engine.ids, engine.x, engine.shape.reshape(-1, 8, 3),
-                                     engine.rot_e)
-    residual = engine._residual(engine.x, engine.rot_e)
+    hand_over(twin.strategy.engine, engine)
+    engine.residual.update_shapes(engine.phi)
+    engine.residual.fit_rotations(engine.x, engine.rot_e)
+    residual = engine.residual.strip_rows(engine.x, engine.rot_e)
     size = float(np.ptp(pattern.vertices, axis=0).max())
     # every strip row within 1e-10 × size (the twin's tolerance) of its target
-    assert np.abs(residual / engine.sqrt_w[:, None, None]).max() < 1e-10 * size
+    assert np.abs(residual / engine.residual.sqrt_w[:, None, None]).max() < 1e-10 * size
 
 
-def test_an_interrupted_coarse_phase_ends_at_the_twins_state(monkeypatch):
+def test_an_interrupted_coarse_phase_ends_at_the_twins_state():
     pattern, mesh, _, _ = miura()
-    monkeypatch.setattr(rigid_strategy, "COARSE_START", True)
-    sim = Simulation(mesh, pattern)
+    sim = simulation(mesh, pattern, True)
     result = sim.run(tolerance=TOL, callback=lambda s, moved: s.iterations < 12)
     assert result.reason == "callback" and result.iterations == 12
     assert sim.strategy.rigid is None or sim.strategy.rigid.twin is None  # handed over
     assert np.abs(sim.x - mesh.rest_positions).max() > 1e-3  # moved off the rest state
 
 
-def test_no_coarse_start_with_position_targets_or_from_a_state_the_mesh_reached(monkeypatch):
+def test_no_coarse_start_with_position_targets_or_from_a_state_the_mesh_reached():
     pattern, mesh, _, _ = miura(3)
-    monkeypatch.setattr(rigid_strategy, "COARSE_START", True)
-    sim = Simulation(mesh, pattern)
+    sim = simulation(mesh, pattern, True)
     sim.add_position_target([0])
     phases = []
     sim.run(tolerance=1e-6, callback=lambda s, m: phases.append(phase(s)))
     assert "coarse" not in phases
-    monkeypatch.setattr(rigid_strategy, "COARSE_START", False)
-    sim = Simulation(mesh, pattern)
+    sim = Simulation(mesh, pattern)  # (coarse start on: the default)
+    sim.add_position_target([0], name="pin")
     assert sim.run(tolerance=1e-6).converged  # the mesh's own steps
-    monkeypatch.setattr(rigid_strategy, "COARSE_START", True)
+    sim.remove_position_target("pin")
     sim.set_fold_percent(80.0)
     phases = []
     sim.run(tolerance=1e-6, callback=lambda s, m: phases.append(phase(s)))
@@ -141,7 +143,7 @@ def run_phases(sim, percent, tolerance=TOL):
     return result, phases
 
 
-def test_a_run_after_the_twins_certified_hand_over_goes_on_on_the_twin(monkeypatch):
+def test_a_run_after_the_twins_certified_hand_over_goes_on_on_the_twin():
     """A sweep's next frame starts where the twin handed over (the mesh has not moved
     since): it steps the twin again, predictor included, and ends at the mesh's
     equilibrium as the mesh's own steps find it."""
@@ -149,8 +151,7 @@ def test_a_run_after_the_twins_certified_hand_over_goes_on_on_the_twin(monkeypat
     size = Simulation(mesh, pattern).length_scale
     runs = {}
     for coarse in (False, True):
-        monkeypatch.setattr(rigid_strategy, "COARSE_START", coarse)
-        sim = Simulation(mesh, pattern)
+        sim = simulation(mesh, pattern, coarse)
         first, _ = run_phases(sim, 40.0)
         second, phases = run_phases(sim, 45.0)
         assert sim.predict(1.0)  # the last two ends: 40 %, 45 %
@@ -166,12 +167,11 @@ def test_a_run_after_the_twins_certified_hand_over_goes_on_on_the_twin(monkeypat
     assert np.isfinite(angles).all() and np.sign(angles).tolist() == np.sign(half).tolist()
 
 
-def test_the_twin_is_left_once_the_mesh_moves_on_its_own(monkeypatch):
+def test_the_twin_is_left_once_the_mesh_moves_on_its_own():
     """After a certified hand-over, positions the mesh reached otherwise (here a bare
     step of the finishing strategy) start the next run on the mesh itself."""
     pattern, mesh, _, _ = miura(3)
-    monkeypatch.setattr(rigid_strategy, "COARSE_START", True)
-    sim = Simulation(mesh, pattern)
+    sim = simulation(mesh, pattern, True)
     run_phases(sim, 40.0)
     sim.set_fold_percent(45.0)
     sim.step()
@@ -180,15 +180,14 @@ def test_the_twin_is_left_once_the_mesh_moves_on_its_own(monkeypatch):
 
 
 @pytest.mark.parametrize("solver", ["rigid", "hybrid"])
-def test_a_binding_vertex_settles_from_the_twin_as_from_rest(solver, monkeypatch):
+def test_a_binding_vertex_settles_from_the_twin_as_from_rest(solver):
     """W/H = 0.3: the hinge model binds 2.7° short of the closed form; with k sub-strips
     its equilibrium is not the twin's, and the mesh's own steps finish the run."""
     pattern = patterns.degree4_vertex(radius=10.0, widths=[0.3 * 0.01] * 4, mode="A", rho1=70.0)
     mesh = thicken(pattern, 0.01)
     results, phases = [], []
     for coarse in (False, True):
-        monkeypatch.setattr(rigid_strategy, "COARSE_START", coarse)
-        sim = Simulation(mesh, pattern, solver=solver)
+        sim = simulation(mesh, pattern, coarse, solver=solver)
         results.append(sim.run(tolerance=TOL, max_iterations=500,
                                callback=lambda s, moved: phases.append(phase(s))))
     assert all(r.converged for r in results)
@@ -197,16 +196,15 @@ def test_a_binding_vertex_settles_from_the_twin_as_from_rest(solver, monkeypatch
     assert np.nanmax(np.abs(results[0].fold_angles_deg - results[1].fold_angles_deg)) < 1e-4
 
 
-def test_a_fold_from_rest_frees_its_twins_factor_and_a_sweep_keeps_it(monkeypatch):
+def test_a_fold_from_rest_frees_its_twins_factor_and_a_sweep_keeps_it():
     """The twin's normal factor is freed at the certified hand-over of a run from rest
     (the mesh's certificate needs the memory at that peak); a sweep's next frames
     build it once more and keep it (their steps reuse the analysis)."""
     pattern, mesh, _, _ = miura(3)
-    monkeypatch.setattr(rigid_strategy, "COARSE_START", True)
-    sim = Simulation(mesh, pattern)
+    sim = simulation(mesh, pattern, True)
     first, _ = run_phases(sim, 40.0)
-    rigid = sim.strategy._engine
-    assert first.converged and rigid._twin and rigid._twin.engine._normal_factor is None
+    rigid = sim.strategy.rigid_phase
+    assert first.converged and rigid.kept_twin and rigid.kept_twin.engine.lm.factor is None
     second, phases = run_phases(sim, 45.0)
     assert second.converged and "coarse" in phases
-    assert rigid._twin.engine._normal_factor is not None
+    assert rigid.kept_twin.engine.lm.factor is not None

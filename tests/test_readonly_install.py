@@ -88,7 +88,9 @@ def test_a_read_only_install_folds_a_hinge_caching_in_a_fallback_folder(install)
     converged, angle = proc.stdout.split()
     # the same hinge folds to 90° within 0.05° in tests/test_cli.py
     assert converged == "True" and abs(float(angle) - 90.0) < 0.05
-    for package in ("elements", "foldcore"):
+    # numba names a cache folder after the source's folder: the rigid-body kernels'
+    # is foldcore/strategies/rigid
+    for package in ("elements", "rigid"):
         (folder,) = fallback.glob(f"{package}_*")
         assert list(folder.glob("*.nbi")), f"no kernel of {package} was cached"
     # the stale-kernel guard stamps the fallback folder too
@@ -101,7 +103,7 @@ def test_with_no_writable_folder_at_all_kernels_run_uncached(install):
     off, one warning says so, and a kernel still compiles and runs."""
     site, tmp = install
     code = ("import tempfile; tempfile.tempdir = " + repr(str(site)) + "\n"
-            "import foldcore.system, foldcore.rigid_normal\n"
+            "import foldcore.system, foldcore.strategies.rigid.normal\n"
             "from elements._rotation import _det\n"
             "print(_det(2.0, 0.0, 0.0, 0.0, 3.0, 0.0, 0.0, 0.0, 4.0))\n")
     proc = run_child(site, tmp, code)

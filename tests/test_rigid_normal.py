@@ -1,4 +1,4 @@
-"""The rigid-body step's normal equations assembled strip by strip (foldcore.rigid_normal)
+"""The rigid-body step's normal equations assembled strip by strip (strategies/rigid/normal.py)
 equal the ones of the sparse Jacobian it replaces: JᵀJ, Jᵀr, J·v and Jᵀu, with and
 without position targets and M/V side rows acting, to rounding."""
 from __future__ import annotations
@@ -9,25 +9,30 @@ import scipy.sparse as sp
 
 from foldcore import patterns, thicken
 from foldcore.simulation import Simulation
+from foldcore.strategies.rigid import normal as rigid_normal
+from foldcore.strategies.rigid.state import exp_so3, procrustes, skew
+
+from rigid_reference import jacobian
 
 
 def engine_after(pattern, thickness, steps, pin=False):
     mesh = thicken(pattern, thickness)
     sim = Simulation(mesh, pattern, solver="rigid")
     if pin:  # a panel vertex and a hinge-interior one, pulled off their places
-        engine = sim.strategy.engine
-        ids = np.array([engine.on_panel[0], engine.free[len(engine.free) // 2]])
+        lay = sim.strategy.engine.layout
+        ids = np.array([lay.on_panel[0], lay.free[len(lay.free) // 2]])
         sim.add_position_target(ids, mesh.rest_positions[ids] + [0.0, 0.0, 0.5])
     sim.run(tolerance=0.0, max_iterations=steps)
     return sim.strategy.engine
 
 
 def compare(engine):
-    state = engine._state()
-    jac, residual = engine._jacobian(state)
-    lin = engine._linearise(state)
-    n = engine.n_unknowns
-    normal = sp.csc_matrix((lin.normal, engine.csc_indices, engine.csc_indptr), shape=(n, n))
+    state = engine.state()
+    jac, residual = jacobian(engine, state)
+    lin = engine.residual.linearise(state)
+    lay = engine.layout
+    n = lay.n_unknowns
+    normal = sp.csc_matrix((lin.normal, lay.csc_indices, lay.csc_indptr), shape=(n, n))
     reference = sp.tril(jac.T @ jac).tocsc()  # the stored triangle
     scale = abs(reference).max()
     assert abs(normal - reference).max() <= 1e-12 * scale
@@ -49,7 +54,7 @@ def test_miura_normal_equations_match_the_sparse_jacobian(steps):
 def test_position_targets_and_their_panel_layout_match():
     pattern = patterns.miura_one_crease(3, 3, width=0.06)
     engine = engine_after(pattern, 0.02, 2, pin=True)
-    assert (engine.panel_col >= 0).all()  # pinned: no panel holds the rigid motion
+    assert (engine.layout.panel_col >= 0).all()  # pinned: no panel holds the rigid motion
     compare(engine)
 
 
@@ -58,7 +63,7 @@ def test_mv_side_rows_acting_match():
     # wrong side), which is what keeps it off mode A
     pattern = patterns.degree4_vertex(radius=10.0, widths=[0.03] * 4, mode="B", rho1=60.0)
     engine = engine_after(pattern, 0.01, 2)
-    rows, _ = engine._mv_terms(engine.rot_p)
+    rows, _ = engine.residual.mv_terms(engine.rot_p)
     assert np.count_nonzero(rows) == 2
     compare(engine)
 
@@ -67,9 +72,6 @@ def test_the_panel_motion_kernels_match_their_definitions():
     """rotate_by is exp([w]×)·R (Rodrigues, small angles by series); move_panels keeps
     each panel's joints where the linear step puts them, in the weighted least-squares
     sense: the joints' weighted mean of (rigid − linear) motion is zero; to rounding."""
-    from foldcore import rigid_normal
-    from foldcore.rigid_body import exp_so3, skew
-
     rng = np.random.default_rng(7)
     n_panels, n_joints = 6, 40
     rot = exp_so3(rng.standard_normal((n_panels, 3)))
@@ -104,9 +106,6 @@ def test_place_sides_carries_a_shape_by_the_motion_that_fits_its_known_side():
     """A bent strip moved rigidly: its known side where the motion put it, the other
     side placed from the shape comes out where the same motion puts it (to rounding);
     with the known side perturbed, the fit is the Procrustes one (SVD reference)."""
-    from foldcore import rigid_normal
-    from foldcore.rigid_body import exp_so3, procrustes
-
     rng = np.random.default_rng(11)
     b = 5
     shape = rng.standard_normal((b, 8, 3)) * [3.0, 1.0, 0.1]  # mm, a strip's 8 points

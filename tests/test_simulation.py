@@ -205,7 +205,7 @@ def test_position_target_can_be_moved_and_removed():
     sim.run(tolerance=0, max_iterations=50)
     assert sim.positions[corner, 2] > H / 2
     sim.remove_position_target(name)
-    assert not sim._position_targets
+    assert not sim.model.position_targets
 
 
 @pytest.mark.parametrize("call, message", [
@@ -275,13 +275,13 @@ def test_angle_actuation_stiffens_the_actuated_strips_only():
     mesh = thicken(pattern, 2.0)
     g = mesh.groups["bending_hinge"]
     sim = Simulation(mesh, pattern, actuation="angle")
-    weights = sim.system.weights[sim._hinge_index]
+    weights = sim.system.weights[sim.model.hinge_index]
     np.testing.assert_array_equal(weights, np.where(g.source == 0, ACTUATION_STIFFNESS, 1.0)
                                   * g.weights)
     sim.set_fold_angles({0: None})
-    np.testing.assert_array_equal(sim.system.weights[sim._hinge_index], g.weights)
+    np.testing.assert_array_equal(sim.system.weights[sim.model.hinge_index], g.weights)
     equal = Simulation(mesh, pattern)
-    np.testing.assert_array_equal(equal.system.weights[equal._hinge_index], g.weights)
+    np.testing.assert_array_equal(equal.system.weights[equal.model.hinge_index], g.weights)
     with pytest.raises(SimulationError, match="unknown actuation 'motor'"):
         Simulation(mesh, pattern, actuation="motor")
 
@@ -305,6 +305,6 @@ def test_k_is_factorised_at_its_first_use_and_then_matches_the_current_weights()
     result = sim.run(tolerance=0, max_iterations=2)
     assert sim.system.factored and result.timings_s["bare_solve"] > 0
     rhs = np.random.default_rng(3).standard_normal((mesh.n_vertices, 3))
-    fresh = Factor(sim.system._with_pins(), sim.system.backend)
+    fresh = Factor(sim.system.with_pins(), sim.system.backend)
     np.testing.assert_allclose(sim.system.factor.solve(rhs), fresh.solve(rhs), rtol=1e-10,
                                atol=1e-12 * np.abs(fresh.solve(rhs)).max())

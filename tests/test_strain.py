@@ -133,6 +133,6 @@ def test_accelerated_strategy_checks_limits_when_a_result_is_taken_after_bare_st
                      strain_limits=StrainLimits(tension=eq8_limit(THETA_F)))
     for _ in range(300):
         sim.step()
-    assert sim._monitor.failures == []
+    assert sim.failures == []
     (failure,) = sim.result(False).failures
     assert failure["mode"] == "tension" and failure["fold_angle_deg"] > THETA_F

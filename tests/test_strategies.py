@@ -35,9 +35,9 @@ def test_a_user_strategy_registers_by_class_and_runs():
         name = "test_half_step"
 
         def step(self):
-            old = self.sim.x
+            old = self.model.x
             energy, moved = super().step()
-            self.sim.x = 0.5 * (old + self.sim.x)
+            self.model.x = 0.5 * (old + self.model.x)
             return energy, 0.5 * moved
 
     try:
@@ -49,7 +49,7 @@ def test_a_user_strategy_registers_by_class_and_runs():
         paper.step()
         np.testing.assert_allclose(sim.x, 0.5 * (mesh.rest_positions + paper.x), atol=1e-12)
     finally:
-        strategies._REGISTRY.pop("test_half_step", None)
+        strategies.unregister("test_half_step")
 
 
 def test_unknown_and_nameless_strategies_are_refused():
@@ -138,11 +138,11 @@ def test_newton_hessian_in_its_fixed_pattern_is_the_direct_sum():
     sim = Simulation(mesh, pattern, solver="newton")
     sim.run(tolerance=0, max_iterations=3)
     newton = sim.strategy
-    _, _ = sim.local_step(sim.x)
-    values = newton._hessian(sim._targets)
-    lower = newton._pattern.matrix(values, 0.0).toarray()
-    dense = np.kron(sim.system._with_pins().toarray(), np.eye(3))
-    for ids, weights, basis in newton._rotation_bases(sim._targets):
+    _, _ = sim.model.local_step(sim.x)
+    values = newton.hessian(sim.model.slot_targets)
+    lower = newton.hessian_pattern.matrix(values, 0.0).toarray()
+    dense = np.kron(sim.system.with_pins().toarray(), np.eye(3))
+    for ids, weights, basis in newton.rotation_bases(sim.model.slot_targets):
         for v, w, q in zip(ids, weights, basis):
             dof = (3 * v[:, None] + np.arange(3)).ravel()
             dense[np.ix_(dof, dof)] -= w * q @ q.T

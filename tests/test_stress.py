@@ -129,8 +129,8 @@ def test_incompatible_actuation_settles_with_finite_energy(solver):
 
 def panel_residual(sim) -> float:
     """Σ over panels of ‖C x − R·rest‖² (mm²): zero for exactly rigid panels."""
-    run = next(r for r in sim._runs if r.group.kind == "rigid_panel")
-    run.project(sim.x, sim._targets, np.zeros(len(run.group)))
+    run = next(r for r in sim.model.groups if r.group.kind == "rigid_panel")
+    run.project(sim.x, sim.model.slot_targets, np.zeros(len(run.group)))
     return float(run.energy.sum())
 
 

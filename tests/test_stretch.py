@@ -60,7 +60,7 @@ def test_passive_stretch_hinge_stays_at_rest_and_can_be_released():
     np.testing.assert_allclose(sim.stretch_ratios(), [[1.0, 1.0]], atol=1e-9)
     sim.set_stretch_ratios({0: LAMBDA})
     sim.set_stretch_ratios({0: None})  # passive again: the target is the current width
-    assert np.isnan(sim._stretch.params[0, 2])
+    assert np.isnan(sim.model.stretch.params[0, 2])
 
 
 def test_stretch_input_errors_name_the_edge():

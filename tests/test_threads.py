@@ -134,6 +134,6 @@ def test_a_simulation_keeps_the_users_thread_count():
 
     pattern = patterns.miura_one_crease(5, 5, width=0.6)
     mesh = thicken(pattern, 0.2)
-    assert Simulation(mesh, pattern, threads=1)._chooser is None
+    assert Simulation(mesh, pattern, threads=1).thread_chooser is None
     sim = Simulation(mesh, pattern)
-    assert sim._chooser is not None and sim._chooser.most == sim.threads
+    assert sim.thread_chooser is not None and sim.thread_chooser.most == sim.threads

@@ -1,6 +1,6 @@
 """`converged` means the fold was reached (issue 18's first item): a stall of small
 steps is not a verdict, for the rigid-body strategies (their own test) and the
-local/global ones (the equilibrium probe, :mod:`foldcore.verdict`).
+local/global ones (the equilibrium probe, :mod:`foldcore.probe`).
 
 Reproducer: a thin Miura from flat, one crease driven. Its hinges are so stiff
 against the sheet's size that Levenberg–Marquardt leaves the flat state in steps
@@ -15,7 +15,7 @@ import pytest
 
 from foldcore import patterns, thicken
 from foldcore.simulation import Simulation
-from foldcore.verdict import PROBE_STEPS
+from foldcore.probe import PROBE_STEPS
 
 A = 20.0  # mm, facet side
 
@@ -99,7 +99,7 @@ def test_the_probe_leaves_the_model_as_it_was():
     for _ in range(5):
         a.step(), b.step()
     before = a.timings["projection"]
-    a.equilibrium.probe()
+    a.convergence.probe.probe()
     assert a.timings["projection"] > before  # it did project
     for _ in range(3):
         assert a.step() == b.step()
@@ -246,23 +246,24 @@ def test_a_converged_binding_fold_is_within_the_tolerance_of_its_equilibrium():
     assert np.abs(loose.positions - tight.positions).max() <= 2 * limit
 
 
-def test_extrapolating_a_binding_tail_keeps_the_equilibrium(monkeypatch):
+def test_extrapolating_a_binding_tail_keeps_the_equilibrium():
     """At a binding equilibrium Gauss–Newton's steps shrink by a steady ratio; the
-    step scaled to the end of that tail (rigid_body.RigidBodySolver._extrapolated)
+    step scaled to the end of that tail (LevenbergMarquardt.extrapolated)
     must reach an equilibrium as low in fewer iterations (measured 187 → 127 on
     this sheet). The flat state's equilibria form a valley: at tolerance 1e-13
     both ways end 3e-6 mm (7e-6°) apart at energies equal to 1e-15, so the
     check is the energy (two minima of one valley: equal to rounding, 1e-12)
     and the angles to 1e-4° (the corpus's "same state"), not the positions."""
-    from foldcore import rigid_body
+    from foldcore.strategies.hybrid import HybridOptions
+    from foldcore.strategies.rigid import RigidOptions
 
     n, gamma = 6, 84.0
     angles = patterns.miura_fold_angles(n, n, gamma, 90.0)
     pattern = patterns.miura(n, n, a=A, b=A, gamma=gamma).replace(fold_angles=angles)
     mesh = thicken(pattern, 0.01 * A)
     jumped = Simulation(mesh, pattern).run(tolerance=1e-9, max_iterations=3000)
-    monkeypatch.setattr(rigid_body, "EXTRAPOLATE_COS", 2.0)  # no two steps are aligned
-    plain = Simulation(mesh, pattern).run(tolerance=1e-9, max_iterations=3000)
+    never = HybridOptions(rigid=RigidOptions(extrapolate_cos=2.0))  # no two steps aligned
+    plain = Simulation(mesh, pattern, options=never).run(tolerance=1e-9, max_iterations=3000)
     assert jumped.converged and plain.converged
     assert jumped.iterations < plain.iterations
     assert jumped.energy[-1] == pytest.approx(plain.energy[-1], rel=1e-12)
@@ -281,7 +282,7 @@ def test_newton_at_its_resolution_ends_stalled_not_at_the_budget():
     1e-13: limit 1.2e-11 mm), the rigid phase hands over to ``newton``, whose
     steps then wander at ~1e-8 mm with E unchanged to rounding; they took the
     whole 3 000-step budget (23 s). Now the run ends ``stalled`` once
-    ``STALL_STEPS`` accepted steps changed E by no more than rounding, and it is
+    ``stall_steps`` accepted steps changed E by no more than rounding, and it is
     not converged."""
     from foldcore.strategies import newton
 
@@ -290,7 +291,7 @@ def test_newton_at_its_resolution_ends_stalled_not_at_the_budget():
     result = sim.run(tolerance=1e-13, max_iterations=3000)
     assert result.reason == "stalled" and not result.converged
     assert result.iterations < 1000
-    tail = result.energy[-newton.STALL_STEPS:]
+    tail = result.energy[-newton.NewtonOptions().stall_steps:]
     noise = newton.ROUNDING * result.energy.max() + sim.strategy.finish.energy_floor
     assert np.ptp(tail) <= 2 * noise
 
@@ -298,16 +299,14 @@ def test_newton_at_its_resolution_ends_stalled_not_at_the_budget():
 def test_steps_that_still_shrink_at_rounding_level_are_not_a_stall():
     """The stall needs steps that no longer shrink: a tail contracting by 0.85 a step
     within E's rounding is converging (the rigid phase's own test measured such
-    a tail, RigidBodySolver.stalls)."""
-    from foldcore.strategies import newton
-
+    a tail, StoppingRule.stalls)."""
     pattern, mesh = flat_miura6()
-    strategy = newton.Newton(Simulation(mesh, pattern, solver="newton"))
-    n = newton.STALL_STEPS
-    strategy._level = n - 1
-    strategy._moves = [1e-8] * n
+    strategy = Simulation(mesh, pattern, solver="newton").strategy
+    n = strategy.options.stall_steps
+    strategy.level = n - 1
+    strategy.moves = [1e-8] * n
     assert not strategy.stalled  # one step short of the count
-    strategy._level = n
+    strategy.level = n
     assert strategy.stalled  # wandering at one size
-    strategy._moves = list(1e-8 * 0.85 ** np.arange(n))
+    strategy.moves = list(1e-8 * 0.85 ** np.arange(n))
     assert not strategy.stalled

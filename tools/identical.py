@@ -84,7 +84,7 @@ def _find(names: list[str], attr: str):
 
 TWIN_MODULES = ["foldcore.coarse", "foldcore.strategies.rigid.twin",
                 "foldcore.strategies.rigid.coarse", "foldcore.strategies.twins",
-                "foldcore.twins"]
+                "foldcore.twins", "foldcore.strategies.hybrid.rings"]
 
 
 def mesh_cases():

@@ -165,7 +165,7 @@ class System:
         Miura 50 × 50 (88 796 vertices, nnz(L) 2.0 M) it was 75 MB of the fold's
         memory (RSS), and the coarse twin's Simulation factorised its own."""
         if self._factor is None:
-            self._factor = Factor(self._with_pins(), self.backend)
+            self._factor = Factor(self.with_pins(), self.backend)
         return self._factor
 
     @property
@@ -196,7 +196,8 @@ class System:
         self._refactor()
         return True
 
-    def _with_pins(self):
+    def with_pins(self):
+        """K with the pins, (N, N) CSC, mm³ (what the factor factorises)."""
         return (self.matrix + sp.diags(self._pins)).tocsc()
 
     def set_pin_weights(self, pins: np.ndarray) -> bool:
@@ -209,7 +210,7 @@ class System:
 
     def _refactor(self) -> None:
         if self._factor is not None:  # else the first use factorises the new K
-            self._factor.refactor(self._with_pins())
+            self._factor.refactor(self.with_pins())
         self.version += 1
 
     def apply(self, x: np.ndarray) -> np.ndarray:

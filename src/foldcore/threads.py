@@ -35,6 +35,8 @@ import threading
 from contextlib import contextmanager, nullcontext
 from statistics import median_low
 
+import numpy as np
+
 # threadpoolctl.ThreadpoolController, built on first use: by then a Simulation
 # exists, and building one loads numpy's and scipy's BLAS (checked)
 _controller = None
@@ -146,3 +148,27 @@ class ThreadChooser:
                 else self.EXPLORE_EVERY
             self._until, self._probing = self._interval, None
 
+
+
+#: Element-vertex slots below which a simulation's kernels run on one thread (a
+#: parallel launch costs more than it saves there): `docs/design.md#threads`.
+SERIAL_BELOW_SLOTS = 500
+#: Vector length (3 × vertices) from which a serial simulation's steps hold BLAS to
+#: one thread too (OpenBLAS threads dot products of such vectors).
+BLAS_GUARD_FROM = 10_000
+
+
+def choose_threads(threads, slots: int) -> int:
+    """numba threads of a simulation: the user's count (checked, 1..numba's), or by
+    default one thread below ``SERIAL_BELOW_SLOTS`` element-vertex slots, else all."""
+    import numba
+
+    from .errors import SimulationError
+
+    if threads is None:
+        return 1 if slots < SERIAL_BELOW_SLOTS else numba.config.NUMBA_NUM_THREADS
+    if not (isinstance(threads, (int, np.integer)) and
+            1 <= threads <= numba.config.NUMBA_NUM_THREADS):
+        raise SimulationError(f"threads must be an integer in "
+                              f"1..{numba.config.NUMBA_NUM_THREADS}, got {threads!r}")
+    return int(threads)

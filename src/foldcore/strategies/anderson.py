@@ -6,18 +6,32 @@ is extrapolated from its last ``memory`` residuals f = G(x) − x, and the
 accelerated point is kept only if its energy is below the previous one —
 else the plain step from the last accepted point is taken and the history
 forgotten. Shared bookkeeping and the energy's gradient:
-:mod:`._accelerated`.
+:mod:`.accelerated`.
 """
 from __future__ import annotations
 
 from collections import deque
+from dataclasses import dataclass
 
 import numpy as np
 
-from ._accelerated import Accelerated
+from .accelerated import Accelerated
 
-ANDERSON_MEMORY = 5  # residuals kept (Peng et al. use 5–6)
-LSTSQ_RCOND = 1e-10  # relative cut-off of the Anderson least-squares solve
+
+@dataclass(frozen=True)
+class AndersonOptions:
+    """Options of ``anderson``.
+
+    Attributes
+    ----------
+    memory : int
+        Residuals kept (Peng et al. use 5–6).
+    lstsq_rcond : float
+        Relative cut-off of the Anderson least-squares solve.
+    """
+
+    memory: int = 5
+    lstsq_rcond: float = 1e-10
 
 
 class Anderson(Accelerated):
@@ -27,7 +41,7 @@ class Anderson(Accelerated):
     """
 
     name = "anderson"
-    MEMORY = ANDERSON_MEMORY
+    Options = AndersonOptions
 
     def _forget(self) -> None:
         self._dg = deque(maxlen=self.memory)
@@ -36,18 +50,18 @@ class Anderson(Accelerated):
         self._last = None  # (energy, G(x)) of the last accepted point
 
     def _advance(self) -> tuple[float, float]:
-        sim = self.sim
-        energy, rhs = sim.local_step(self.x)
+        model = self.model
+        energy, rhs = model.local_step(self.x)
         changed = self._k_changed()
         if self._last is not None and not changed and not energy <= self._last[0]:
             self.rejected += 1  # accelerated point raised E: plain step from the last one
             self.x = self._last[1]
             self._forget()
-            energy, rhs = sim.local_step(self.x)
+            energy, rhs = model.local_step(self.x)
             changed = self._k_changed()
         if changed:
             self._forget()
-        g = sim.global_step(rhs)
+        g = model.global_step(rhs)
         f = g - self.x
         self._last = (energy, g)
         self.x = self._extrapolate(g, f)
@@ -62,5 +76,5 @@ class Anderson(Accelerated):
         if not self._df:
             return g
         df = np.column_stack(self._df)
-        gamma = np.linalg.lstsq(df, f.ravel(), rcond=LSTSQ_RCOND)[0]
+        gamma = np.linalg.lstsq(df, f.ravel(), rcond=self.options.lstsq_rcond)[0]
         return g - (np.column_stack(self._dg) @ gamma).reshape(g.shape)

@@ -4,19 +4,35 @@ Liu, Bouaziz & Kavan 2017, "Quasi-Newton methods for real-time simulation of
 hyperelastic materials": the two-loop recursion with H₀ = K⁻¹ (one K solve
 per iteration) and an Armijo backtracking line search on E; when the search
 fails the plain step is taken and the history forgotten. Shared bookkeeping
-and the energy's gradient: :mod:`._accelerated`.
+and the energy's gradient: :mod:`.accelerated`.
 """
 from __future__ import annotations
 
 from collections import deque
+from dataclasses import dataclass
 
 import numpy as np
 
-from ._accelerated import Accelerated
+from .accelerated import Accelerated
 
-LBFGS_MEMORY = 8  # (s, y) pairs kept
-ARMIJO = 1e-4  # sufficient-decrease constant of the line search
-BACKTRACKS = 4  # halvings before the line search gives up
+
+@dataclass(frozen=True)
+class LbfgsOptions:
+    """Options of ``lbfgs``.
+
+    Attributes
+    ----------
+    memory : int
+        (s, y) pairs kept.
+    armijo : float
+        Sufficient-decrease constant of the line search.
+    backtracks : int
+        Halvings before the line search gives up (then the plain step is taken).
+    """
+
+    memory: int = 8
+    armijo: float = 1e-4
+    backtracks: int = 4
 
 
 class Lbfgs(Accelerated):
@@ -26,15 +42,15 @@ class Lbfgs(Accelerated):
     """
 
     name = "lbfgs"
-    MEMORY = LBFGS_MEMORY
+    Options = LbfgsOptions
 
     def _forget(self) -> None:
         self._pairs = deque(maxlen=self.memory)
         self._at = None  # (energy, ½∇E) already evaluated at self.x
 
     def _evaluate(self, x: np.ndarray) -> tuple[float, np.ndarray]:
-        energy, rhs = self.sim.local_step(x)
-        return energy, self.sim.system.apply(x) - rhs  # ½∇E
+        energy, rhs = self.model.local_step(x)
+        return energy, self.model.system.apply(x) - rhs  # ½∇E
 
     def _advance(self) -> tuple[float, float]:
         if self._at is None or self._k_changed():
@@ -55,7 +71,7 @@ class Lbfgs(Accelerated):
             x_new = self.x + self._direction(grad)
             at_new = self._evaluate(x_new)
         s, y = x_new - self.x, at_new[1] - grad
-        if float(np.vdot(s, y)) > 1e-12 * float(np.vdot(s, s)) * self.sim.system.reference_weight:
+        if float(np.vdot(s, y)) > 1e-12 * float(np.vdot(s, s)) * self.model.system.reference_weight:
             self._pairs.append((s, y, 1.0 / float(np.vdot(s, y))))
         moved = float(np.abs(s).max())
         self.x, self._at = x_new, at_new
@@ -69,7 +85,7 @@ class Lbfgs(Accelerated):
             a = rho * float(np.vdot(s, q))
             q = q - a * y
             alphas.append(a)
-        r = self.sim.global_step(q)
+        r = self.model.global_step(q)
         for (s, y, rho), a in zip(self._pairs, reversed(alphas)):
             b = rho * float(np.vdot(y, r))
             r = r + (a - b) * s
@@ -78,10 +94,10 @@ class Lbfgs(Accelerated):
     def _line_search(self, energy, slope, direction):
         """Armijo backtracking from step 1; (x, (energy, ½∇E)) or (None, None)."""
         step = 1.0
-        for _ in range(BACKTRACKS + 1):
+        for _ in range(self.options.backtracks + 1):
             x = self.x + step * direction
             at = self._evaluate(x)
-            if at[0] <= energy + 2.0 * ARMIJO * step * slope:
+            if at[0] <= energy + 2.0 * self.options.armijo * step * slope:
                 return x, at
             step *= 0.5
         return None, None

@@ -46,23 +46,50 @@ trial's projections serve the next step). Units: mm.
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 import scipy.sparse as sp
 
 from ..errors import SimulationError
 from ..linsolve import Factor
-from . import Strategy
+from .base import Strategy
 
-LAMBDA_START = 1e-3  # initial damping, relative to the diagonal of K ⊗ I₃
-LAMBDA_MIN, LAMBDA_MAX = 1e-12, 1e12
-LAMBDA_DOWN, LAMBDA_UP = 3.0, 5.0  # damping divided after an accepted step, multiplied
-#                                   after a rejected one
-CORRECTIONS = 3  # paper-map steps after each linear step (see the module docstring)
-CONTRACTION_MAX = 0.5  # largest ratio of two accepted steps' lengths that may end a run
-STALL_STEPS = 30  # accepted steps within rounding of E, not shrinking, that end a run stalled
-LAMBDA_SETTLED = 1.0  # largest damping of a step that may end a run
 ROUNDING = 64 * np.finfo(float).eps  # energy change (share of the run's largest) that is noise
 SUPPORTED = {"rigid_panel", "bending_hinge"}  # groups whose projections turn a fixed shape
+
+
+@dataclass(frozen=True)
+class NewtonOptions:
+    """Options of ``newton``.
+
+    Attributes
+    ----------
+    lambda_start : float
+        Initial damping, relative to the diagonal of K ⊗ I₃.
+    lambda_min, lambda_max : float
+        Bounds of the damping.
+    lambda_down, lambda_up : float
+        Damping divided after an accepted step, multiplied after a rejected one.
+    corrections : int
+        Paper-map steps after each linear step (module docstring).
+    contraction_max : float
+        Largest ratio of two accepted steps' lengths that may end a run.
+    stall_steps : int
+        Accepted steps within rounding of E, not shrinking, that end a run stalled.
+    lambda_settled : float
+        Largest damping of a step that may end a run.
+    """
+
+    lambda_start: float = 1e-3
+    lambda_min: float = 1e-12
+    lambda_max: float = 1e12
+    lambda_down: float = 3.0
+    lambda_up: float = 5.0
+    corrections: int = 3
+    contraction_max: float = 0.5
+    stall_steps: int = 30
+    lambda_settled: float = 1.0
 
 
 class Newton(Strategy):
@@ -72,76 +99,77 @@ class Newton(Strategy):
     """
 
     name = "newton"
+    Options = NewtonOptions
 
-    def __init__(self, sim):
-        super().__init__(sim)
-        other = set(sim.mesh.groups) - SUPPORTED
+    def __init__(self, model, progress, options=None):
+        super().__init__(model, progress, options)
+        other = set(model.mesh.groups) - SUPPORTED
         if other:
             raise SimulationError(f"solver 'newton' takes rigid panels, elastic cells and "
                                   f"bending hinges (mesh has {sorted(other)}); use 'lbfgs'")
-        self.lam = LAMBDA_START
+        self.lam = self.options.lambda_start
         self.accepted = False
         self.undamped = False  # whether the last accepted step's damping was ≤ LAMBDA_SETTLED
-        self._moves = []  # the run's accepted step lengths, mm
-        self._level = 0  # accepted steps in a row whose E changed within rounding (stalled)
+        self.moves = []  # the run's accepted step lengths, mm
+        self.level = 0  # accepted steps in a row whose E changed within rounding (stalled)
         self.energy, self.energy_max = np.inf, 0.0  # after the last step; the run's largest, mm⁵
         #: mm⁵: the energy of residuals at rounding level (every vertex off by ROUNDING ×
         #: the size), below which changes are noise even where E is zero (targets met
         #: at rest: a fold at 0 % took 17 rejected factorisations per step before)
-        self.energy_floor = (sim.system.reference_weight * sim.mesh.n_vertices
-                             * (ROUNDING * sim.length_scale) ** 2)
+        self.energy_floor = (model.system.reference_weight * model.mesh.n_vertices
+                             * (ROUNDING * model.length_scale) ** 2)
 
         self._at = None  # the accepted trial's projections, reused by the next step
-        self._pattern = None  # HessianPattern of the current K
+        self.hessian_pattern = None  # HessianPattern of the current K
         self._factor = None  # Factor of H + λ D, refactored in place while the pattern holds
 
     def restart(self) -> None:
-        self.lam, self._moves, self.energy_max, self._level = LAMBDA_START, [], 0.0, 0
+        self.lam, self.moves, self.energy_max, self.level = self.options.lambda_start, [], 0.0, 0
         self._at = None
 
     def begin_run(self) -> None:
-        self._moves, self.energy_max, self._level = [], 0.0, 0
+        self.moves, self.energy_max, self.level = [], 0.0, 0
 
     def step(self) -> tuple[float, float]:
-        sim = self.sim
-        x = sim.x
+        model, o = self.model, self.options
+        x = model.x
         energy, rhs, targets = self._projections(x)
         self.energy_max = max(self.energy_max, energy)
         noise = ROUNDING * self.energy_max + self.energy_floor  # changes that count as none
-        gradient = (sim.system.apply(x) - rhs).ravel()
-        hessian = self._hessian(targets)
+        gradient = (model.system.apply(x) - rhs).ravel()
+        hessian = self.hessian(targets)
         while True:
             delta = self._solve(hessian, -gradient).reshape(-1, 3)
-            if not sim._position_targets:
+            if not model.position_targets:
                 delta = _without_rigid_motion(delta, x)
             trial = self._corrected(x + delta)
-            trial_energy, trial_rhs = sim.local_step(trial)
+            trial_energy, trial_rhs = model.local_step(trial)
             if trial_energy <= energy + noise:
-                self.accepted, self.undamped = True, self.lam <= LAMBDA_SETTLED
-                self.lam = max(self.lam / LAMBDA_DOWN, LAMBDA_MIN)
+                self.accepted, self.undamped = True, self.lam <= o.lambda_settled
+                self.lam = max(self.lam / o.lambda_down, o.lambda_min)
                 break
-            self.lam *= LAMBDA_UP
-            if self.lam > LAMBDA_MAX:  # no decrease at any damping: not a verdict
-                self.accepted, self.lam = False, LAMBDA_START
-                sim.local_step(x)
+            self.lam *= o.lambda_up
+            if self.lam > o.lambda_max:  # no decrease at any damping: not a verdict
+                self.accepted, self.lam = False, o.lambda_start
+                model.local_step(x)
                 return energy, 0.0
         moved = float(np.abs(trial - x).max())
-        self._moves.append(moved)
-        self._level = self._level + 1 if abs(energy - trial_energy) <= noise else 0
+        self.moves.append(moved)
+        self.level = self.level + 1 if abs(energy - trial_energy) <= noise else 0
         self.energy = trial_energy
-        self._at = (trial, trial_energy, trial_rhs.copy(), sim._targets.copy(),
-                    sim.system.version)
-        sim.x = trial
+        self._at = (trial, trial_energy, trial_rhs.copy(), model.slot_targets.copy(),
+                    model.system.version)
+        model.x = trial
         return energy, moved
 
     def _projections(self, x: np.ndarray):
         """(E, b, slot targets) at ``x``: kept from the step that accepted ``x`` while
         K is the same (a stop that closed there refactors it), else projected anew."""
         at, self._at = self._at, None
-        if at is not None and at[0] is x and at[4] == self.sim.system.version:
+        if at is not None and at[0] is x and at[4] == self.model.system.version:
             return at[1], at[2], at[3]
-        energy, rhs = self.sim.local_step(x)
-        return energy, rhs, self.sim._targets
+        energy, rhs = self.model.local_step(x)
+        return energy, rhs, self.model.slot_targets
 
     def settled(self, moved: float, limit: float) -> bool:
         """An accepted step, damped at most ``LAMBDA_SETTLED``, within ``limit`` mm,
@@ -150,11 +178,11 @@ class Newton(Strategy):
         E down to tolerance² of the run's largest (a compatible fold: the residuals
         are at the tolerance, the steps at rounding). A step that no damping makes
         lower E is not a verdict (the run goes on to its budget)."""
-        if not (self.accepted and self.undamped) or moved > limit or len(self._moves) < 2:
+        if not (self.accepted and self.undamped) or moved > limit or len(self.moves) < 2:
             return False
-        ratio = moved / max(self._moves[-2], np.finfo(float).tiny)
-        tolerance = limit / self.sim.length_scale
-        return ratio <= CONTRACTION_MAX or self.energy <= tolerance ** 2 * self.energy_max
+        ratio = moved / max(self.moves[-2], np.finfo(float).tiny)
+        tolerance = limit / self.model.length_scale
+        return ratio <= self.options.contraction_max or self.energy <= tolerance ** 2 * self.energy_max
 
     @property
     def stalled(self) -> bool:
@@ -166,50 +194,51 @@ class Newton(Strategy):
         steps of ~1e-8 mm at E = 0.0713809325 mm⁵ to its 3 000-step budget
         (23 s); steps that still shrink (a contraction of 0.85 at rounding
         level) are converging and go on."""
-        if self._level < STALL_STEPS:
+        steps = self.options.stall_steps
+        if self.level < steps:
             return False
-        third = STALL_STEPS // 3
-        window = self._moves[-STALL_STEPS:]
+        third = steps // 3
+        window = self.moves[-steps:]
         return max(window[-third:]) >= 0.5 * max(window[:third])
 
     def _corrected(self, x: np.ndarray) -> np.ndarray:
         """``x`` after ``CORRECTIONS`` steps of the paper's map (projections, K solve)."""
-        for _ in range(CORRECTIONS):
-            _, rhs = self.sim.local_step(x)
-            x = self.sim.global_step(rhs)
+        for _ in range(self.options.corrections):
+            _, rhs = self.model.local_step(x)
+            x = self.model.global_step(rhs)
         return x
 
-    def _hessian(self, targets: np.ndarray) -> np.ndarray:
+    def hessian(self, targets: np.ndarray) -> np.ndarray:
         """Values of H = K ⊗ I₃ − Σ w Q Qᵀ at the projections ``targets`` (nnz, 3) mm, in
         the fixed pattern of :class:`HessianPattern` (built anew when K changes)."""
-        sim = self.sim
-        bases = list(self._rotation_bases(targets))
-        if self._pattern is None or self._pattern.version != sim.system.version:
-            self._pattern = HessianPattern(sim.system, [ids for ids, _, _ in bases])
+        system = self.model.system
+        bases = list(self.rotation_bases(targets))
+        if self.hessian_pattern is None or self.hessian_pattern.version != system.version:
+            self.hessian_pattern = HessianPattern(system, [ids for ids, _, _ in bases])
             self._factor = None
-        return self._pattern.values([-weights[:, None, None]
+        return self.hessian_pattern.values([-weights[:, None, None]
                                      * np.matmul(basis, basis.transpose(0, 2, 1))
                                      for _, weights, basis in bases])
 
     def _solve(self, values: np.ndarray, rhs: np.ndarray) -> np.ndarray:
         """(H + λ D)⁻¹ rhs, D the diagonal of K ⊗ I₃; the factor keeps its symbolic
         analysis while the pattern stays (CHOLMOD ``cholesky_inplace``)."""
-        matrix = self._pattern.matrix(values, self.lam)
+        matrix = self.hessian_pattern.matrix(values, self.lam)
         if self._factor is None:
-            self._factor = Factor(matrix, self.sim.system.backend, stored="lower")
+            self._factor = Factor(matrix, self.model.system.backend, stored="lower")
         else:
             self._factor.refactor(matrix)
         return self._factor.solve(rhs)
 
-    def _rotation_bases(self, all_targets: np.ndarray):
+    def rotation_bases(self, all_targets: np.ndarray):
         """Per group and element size m: vertex ids (n, m), weights (n,) and an
         orthonormal basis (n, 3m, 3) of the rotations of each element's projection
         (``all_targets``: every group's slot targets, mm)."""
-        sim = self.sim
-        for run, weights in zip(sim._runs, sim.system.weights):
-            group = run.group
+        model = self.model
+        for state, weights in zip(model.groups, model.system.weights):
+            group = state.group
             sizes = np.diff(group.indptr)
-            targets = all_targets[run.slots]
+            targets = all_targets[state.slots]
             for m in np.unique(sizes):
                 sel = np.flatnonzero(sizes == m)
                 slots = group.indptr[sel][:, None] + np.arange(m)
@@ -240,7 +269,7 @@ class HessianPattern:
     Parameters
     ----------
     system : foldcore.system.System
-        Its K with the pins (``_with_pins``), N × N.
+        Its K with the pins (``with_pins``), N × N.
     blocks : list of (n, m) int arrays
         Vertex ids of each run of elements of size m, in the order their
         values will be given to :meth:`values`.
@@ -248,7 +277,7 @@ class HessianPattern:
 
     def __init__(self, system, blocks):
         self.version = system.version
-        base = sp.kron(system._with_pins(), sp.identity(3), format="coo")
+        base = sp.kron(system.with_pins(), sp.identity(3), format="coo")
         rows, cols = [base.row], [base.col]
         for ids in blocks:
             n, m = ids.shape

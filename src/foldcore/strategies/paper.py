@@ -4,7 +4,7 @@ Every element is projected at x (the local step, in parallel), the weighted
 targets are gathered into b(x), and the prefactored K gives the new
 positions (the global step). Monotone in the energy, but it moves a long
 panel only through its thin hinge faces, so its iteration count grows with
-(panel length / thickness)² (DESIGN.md, "Convergence").
+(panel length / thickness)²: `docs/design.md#why-more-than-the-papers-map`.
 """
 from __future__ import annotations
 
@@ -13,7 +13,7 @@ import time
 import numpy as np
 
 from ..system import take_solution
-from . import Strategy
+from .base import Strategy
 
 
 class PaperMap(Strategy):
@@ -23,12 +23,12 @@ class PaperMap(Strategy):
     plain_map = True
 
     def step(self) -> tuple[float, float]:
-        sim = self.sim
-        energy, rhs = sim.local_step(sim.x)
+        model = self.model
+        energy, rhs = model.local_step(model.x)
         t0 = time.perf_counter()
-        solution = sim.system.factor.solve(rhs)
-        new_x = np.empty(sim.x.shape)
-        moved = float(take_solution(solution, sim.x, new_x))
-        sim.timings["solve"] += time.perf_counter() - t0
-        sim.x = new_x
+        solution = model.system.factor.solve(rhs)
+        new_x = np.empty(model.x.shape)
+        moved = float(take_solution(solution, model.x, new_x))
+        model.timings["solve"] += time.perf_counter() - t0
+        model.x = new_x
         return energy, moved
