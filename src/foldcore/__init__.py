@@ -16,6 +16,7 @@ Data flow: pattern → thick mesh → system → simulation → result → outpu
 Units: mm and degrees at every public API. Submodules are imported lazily so
 that ``import foldcore`` is fast and never imports numba kernels or pyvista.
 """
+import logging
 import os
 from importlib import import_module
 
@@ -30,6 +31,10 @@ from .errors import (FoldcoreError, KernelCacheWarning, MeshError, PatternError,
                      RunWarning, SimulationError)
 
 __version__ = "0.1.0"
+
+# The library logs through the "foldcore" logger and says nothing unless asked
+# (``foldcore -v``, or a handler of the application's own).
+logging.getLogger(__name__).addHandler(logging.NullHandler())
 
 _LAZY = {
     "CreasePattern": ("foldcore.pattern", "CreasePattern"),

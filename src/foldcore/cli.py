@@ -22,6 +22,7 @@ one line per kind, with a count of the repeats.
 from __future__ import annotations
 
 import argparse
+import logging
 import math
 import re
 import sys
@@ -118,8 +119,37 @@ def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="foldcore", description="Thick-origami simulation.")
     parser.add_argument("--version", action="version", version=f"foldcore {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
-    sim = sub.add_parser("simulate", help="fold a crease pattern (FOLD, or OBJ/STL + hinges)")
-    sim.add_argument("pattern", help="crease pattern: .fold, or .obj/.stl with a .hinges file")
+    _add_simulate(sub)
+    _add_render(sub)
+    _add_export(sub)
+    view = sub.add_parser("view", help="a self-contained interactive HTML page of a result "
+                                       "FOLD (simulate -o or --series)")
+    view.add_argument("result", help="FOLD file written by foldcore simulate -o / --series")
+    view.add_argument("-o", "--output", required=True, help="HTML page to write")
+    _add_scene(sub)
+    for command in sub.choices.values():
+        command.add_argument("-v", "--verbose", action="count", default=0,
+                             help="log what the run does (stages, phase hand-overs, "
+                                  "refactorisations, thread choices) on stderr; -vv: more")
+    return parser
+
+
+def _add_simulate(sub) -> None:
+    sim = sub.add_parser("simulate", help="fold a crease pattern (FOLD, SVG, or OBJ/STL + "
+                                          "hinges)")
+    sim.add_argument("pattern", help="crease pattern: .fold, .svg, or .obj/.stl with a "
+                                     ".hinges file")
+    _add_reading(sim)
+    _add_thickening(sim)
+    _add_solving(sim)
+    sim.add_argument("-q", "--quiet", action="store_true",
+                     help="no progress bar and no summary line on stderr (warnings and "
+                          "errors are still said); the bar shows only on a terminal, "
+                          f"after {PROGRESS_DELAY:g} s")
+    _add_outputs(sim)
+
+
+def _add_reading(sim) -> None:
     sim.add_argument("--hinges", help="hinge file of an OBJ/STL pattern (default: PATTERN.hinges)")
     sim.add_argument("--mv-passive", action="store_true",
                      help="in a FOLD file without edges_foldAngle, M/V creases stay passive "
@@ -135,6 +165,9 @@ def build_parser() -> argparse.ArgumentParser:
     size.add_argument("--sheet-size", type=_positive, metavar="MM",
                       help="scale the pattern so that its larger extent is MM millimetres "
                            "(a unit-square file is otherwise 1 mm wide)")
+
+
+def _add_thickening(sim) -> None:
     sim.add_argument("--thickness", type=_positive,
                      help="sheet thickness H in mm (default: the file's foldcore:thickness)")
     sim.add_argument("--hinge-width", type=_positive,
@@ -146,20 +179,6 @@ def build_parser() -> argparse.ArgumentParser:
                      help="elastic panels: cut every face into rings of cells about MM mm "
                           "long, so panels bend and stretch where the targets ask for it "
                           "(non-rigidly-foldable patterns); default: rigid panels")
-    sim.add_argument("--fold-percent", type=float, default=100.0,
-                     help="scale all target angles, -100…100 (default 100)")
-    sim.add_argument("--solver", default=DEFAULT_SOLVER, choices=SOLVERS,
-                     help="iteration strategy: paper (the paper's local/global map), "
-                          "anderson (the same map, safeguarded Anderson acceleration), lbfgs "
-                          "(L-BFGS on the same energy, K as initial Hessian) or rigid "
-                          "(panels as rigid bodies, Levenberg-Marquardt; far fewer iterations "
-                          "on long panels, rigid panels only), hybrid (rigid steps, then "
-                          "lbfgs on the paper's energy; with --elastic-cells, rigid steps "
-                          "on rigid panels, then newton) or newton (Gauss-Newton on every "
-                          "vertex); default: " + DEFAULT_SOLVER)
-    sim.add_argument("--tolerance", type=_positive, default=1e-8,
-                     help="stop when the largest step is below this × pattern size")
-    sim.add_argument("--max-iterations", type=int, default=10_000)
     sim.add_argument("--hinge", choices=HINGE_MODELS,
                      help="hinge model of every crease: axis (panels turn about the crease, "
                           "rigid-origami kinematics at any thickness), arc (the paper's "
@@ -167,6 +186,21 @@ def build_parser() -> argparse.ArgumentParser:
                           f"the file's foldcore:edges_hinge, else {DEFAULT_HINGE}")
     sim.add_argument("--eq8", dest="hinge", action="store_const", const="eq8",
                      help="same as --hinge eq8")
+
+
+def _add_solving(sim) -> None:
+    sim.add_argument("--fold-percent", type=float, default=100.0,
+                     help="scale all target angles, -100…100 (default 100)")
+    sim.add_argument("--solver", default=DEFAULT_SOLVER, choices=SOLVERS,
+                     help="iteration strategy: hybrid (default: rigid-body steps, then "
+                          "newton where they cannot finish), rigid (panels as rigid bodies, "
+                          "Levenberg-Marquardt), newton (Gauss-Newton on every vertex), "
+                          "paper (the paper's local/global map), anderson or lbfgs (the "
+                          "same map accelerated)")
+    sim.add_argument("--tolerance", type=_positive, default=1e-8,
+                     help="stop when the state is this × the pattern size from its "
+                          "equilibrium (default 1e-8)")
+    sim.add_argument("--max-iterations", type=int, default=10_000)
     sim.add_argument("--actuation", choices=ACTUATIONS, default=DEFAULT_ACTUATION,
                      help="equal (an actuated hinge weighs what a passive one does, the "
                           "paper's) or angle (actuated hinges 1000x stiffer: their angles are "
@@ -176,10 +210,9 @@ def build_parser() -> argparse.ArgumentParser:
                      help="from a flat sheet, first fold with passive M/V creases held at "
                           "least DEG degrees on their assigned side, then release them "
                           f"(branch selection; 0 turns it off; default {BRANCH_FLOOR_DEG:g})")
-    sim.add_argument("-q", "--quiet", action="store_true",
-                     help="no progress bar and no summary line on stderr (warnings and "
-                          "errors are still said); the bar shows only on a terminal, "
-                          f"after {PROGRESS_DELAY:g} s")
+
+
+def _add_outputs(sim) -> None:
     sim.add_argument("-o", "--output", help="write the result as FOLD (achieved angles + "
                                             "folded solid in file_frames)")
     sim.add_argument("--report", help="write the JSON report here")
@@ -197,6 +230,8 @@ def build_parser() -> argparse.ArgumentParser:
     sim.add_argument("--fps", type=_fps, default=10.0,
                      help="animation frames per second (default 10)")
 
+
+def _add_render(sub) -> None:
     ren = sub.add_parser("render", help="render a result FOLD (simulate -o) to PNG")
     ren.add_argument("result", help="FOLD file written by foldcore simulate -o")
     ren.add_argument("-o", "--output", required=True, help="PNG to write")
@@ -211,6 +246,8 @@ def build_parser() -> argparse.ArgumentParser:
                           "or each sub-strip's largest surface tension (strain)")
     _add_rebuild_options(ren)
 
+
+def _add_export(sub) -> None:
     exp = sub.add_parser("export", help="fabrication files of a result FOLD (simulate -o)")
     exp.add_argument("result", help="FOLD file written by foldcore simulate -o")
     exp.add_argument("--svg", help="flat sheet outlines as SVG (mm)")
@@ -223,11 +260,8 @@ def build_parser() -> argparse.ArgumentParser:
                      help="SVG margin around the sheet in mm (default: 2%% of the sheet)")
     _add_rebuild_options(exp)
 
-    view = sub.add_parser("view", help="a self-contained interactive HTML page of a result "
-                                       "FOLD (simulate -o or --series)")
-    view.add_argument("result", help="FOLD file written by foldcore simulate -o / --series")
-    view.add_argument("-o", "--output", required=True, help="HTML page to write")
 
+def _add_scene(sub) -> None:
     from .scenes import NAMES
 
     scn = sub.add_parser("scene", help="fold one of the paper's scenes and write its outputs")
@@ -240,7 +274,6 @@ def build_parser() -> argparse.ArgumentParser:
                      help="iteration strategy (default: the scene's own, see its docstring)")
     scn.add_argument("--quick", action="store_true",
                      help="lower iteration budgets (tests); same geometry")
-    return parser
 
 
 def run_scene(args) -> int:
@@ -264,14 +297,13 @@ def run_scene(args) -> int:
 def simulate(args) -> int:
     """Run ``foldcore simulate`` (:func:`foldcore.job.fold`); raises FoldcoreError on
     bad input."""
-    from .job import Interrupted, defaults, fold
+    from .job import Interrupted, fold
 
     progress = _progress(args)
-    options = {name: getattr(args, name) for name in defaults() if name != "callback"}
     try:
-        done = fold(args.pattern, callback=progress, **options)
+        done = fold(args.pattern, callback=progress, **option_groups(args))
     except Interrupted as stop:
-        written = ", ".join(f"{k} {v}" for k, v in stop.written.items())
+        written = ", ".join(f"{in_flags(k)} {v}" for k, v in stop.written.items())
         print(f"foldcore: interrupted (SIGINT) after {stop.result.iterations} iterations; "
               + (f"the last iterate was written as a partial result ({written}; marked "
                  "foldcore:partial)" if written else "no output was asked for"),
@@ -288,6 +320,33 @@ def simulate(args) -> int:
     if not args.quiet:
         print(done.summary, file=sys.stderr)
     return 0
+
+
+def option_groups(args) -> dict:
+    """The library's option groups (:mod:`foldcore.options`) from the flags."""
+    from .io import Reading
+    from .options import Outputs, Solving, Thickening
+
+    return {"hinges": args.hinges,
+            "reading": Reading(mv_without_angle="passive" if args.mv_passive else "fold",
+                               trust_assignment=args.trust_assignment, scale=args.scale,
+                               size=args.sheet_size),
+            "thickening": Thickening(args.thickness, args.hinge_width, args.subdivisions,
+                                     args.hinge, args.elastic_cells),
+            "solving": Solving(args.fold_percent, args.solver, args.tolerance,
+                               args.max_iterations, args.actuation, args.branch_floor),
+            "outputs": Outputs(args.output, args.report, args.render, args.animate,
+                               args.series, args.frames, args.fps)}
+
+
+def in_flags(text: str) -> str:
+    """A library message in the command line's words: each option name
+    (``group.field``) replaced by its flag (:data:`foldcore.options.FLAGS`)."""
+    from .options import FLAGS
+
+    for name in sorted(FLAGS, key=len, reverse=True):
+        text = text.replace(name, FLAGS[name])
+    return text
 
 
 class _Progress:
@@ -418,8 +477,8 @@ def _warning_lines(caught) -> list[str]:
         key = (w.category.__name__, re.sub(r"\d+(\.\d+)?", "#", text))
         first.setdefault(key, text)
         counts[key] = counts.get(key, 0) + 1
-    return [f"foldcore: warning: {first[k]}" + (f" (and {counts[k] - 1} more like it)"
-                                                 if counts[k] > 1 else "")
+    return [f"foldcore: warning: {in_flags(first[k])}" + (f" (and {counts[k] - 1} more like it)"
+                                                           if counts[k] > 1 else "")
             for k in first]
 
 
@@ -442,6 +501,7 @@ def main(argv=None) -> int:
         return exc.code
     in_main_thread = threading.current_thread() is threading.main_thread()
     previous = signal.signal(signal.SIGTERM, _terminate) if in_main_thread else None
+    handler = _log_to_stderr(args.verbose)
     try:
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
@@ -450,7 +510,7 @@ def main(argv=None) -> int:
             print(line, file=sys.stderr)
         return code
     except FoldcoreError as exc:
-        print(f"foldcore: error: {exc}", file=sys.stderr)
+        print(f"foldcore: error: {in_flags(str(exc))}", file=sys.stderr)
     except OSError as exc:
         name = exc.filename or getattr(args, "pattern", None) or getattr(args, "result", "")
         print(f"foldcore: error: {name}: {exc.strerror or exc}", file=sys.stderr)
@@ -465,7 +525,22 @@ def main(argv=None) -> int:
     finally:
         if in_main_thread:
             signal.signal(signal.SIGTERM, previous)
+        if handler is not None:
+            logging.getLogger("foldcore").removeHandler(handler)
     return EXIT_BAD_INPUT
+
+
+def _log_to_stderr(verbosity: int):
+    """The ``foldcore`` logger on stderr at INFO (``-v``) or DEBUG (``-vv``); the
+    handler, to remove after the command (None: quiet, the library's default)."""
+    if not verbosity:
+        return None
+    handler = logging.StreamHandler(sys.stderr)
+    handler.setFormatter(logging.Formatter("foldcore: %(message)s"))
+    logger = logging.getLogger("foldcore")
+    logger.addHandler(handler)
+    logger.setLevel(logging.INFO if verbosity == 1 else logging.DEBUG)
+    return handler
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -17,8 +17,8 @@ from __future__ import annotations
 import warnings
 from dataclasses import dataclass
 
-from .actuation import BRANCH_FLOOR_DEG, DEFAULT_ACTUATION
-from .strategies import DEFAULT_SOLVER
+from .errors import RunWarning
+from .options import OptionError
 
 
 @dataclass(frozen=True)
@@ -34,7 +34,7 @@ class Loaded:
 class Interrupted(KeyboardInterrupt):
     """Ctrl-C during the run: the last iterate was written as a partial result
     (``foldcore:partial`` in the FOLD file, ``reason: "interrupted"`` in the
-    report) to ``written`` (option name → path); ``result`` is that iterate."""
+    report) to ``written`` (``outputs.field`` → path); ``result`` is that iterate."""
 
     def __init__(self, result, written: dict):
         super().__init__()
@@ -78,45 +78,25 @@ def load(path, *, hinges=None, reading=None) -> Loaded:
     return Loaded(read(source, hinges=hinges), None, None, None)
 
 
-def simulate(path, *, thickness: float | None = None, hinge_width: float | None = None,
-             subdivisions="auto", fold_percent: float = 100.0, solver: str = DEFAULT_SOLVER,
-             tolerance: float = 1e-8, max_iterations: int = 10_000, hinge: str | None = None,
-             actuation: str = DEFAULT_ACTUATION, branch_floor: float = BRANCH_FLOOR_DEG,
-             hinges=None, mv_passive: bool = False, trust_assignment: bool = False,
-             scale: float | None = None, sheet_size: float | None = None,
-             elastic_cells: float | None = None, output=None, report=None, render=None,
-             animate=None, series=None, frames: int = 20, fps: float = 10.0, callback=None):
+def simulate(path, *, hinges=None, reading=None, thickening=None, solving=None,
+             outputs=None, callback=None):
     """Fold the pattern file at ``path`` and write the outputs asked for; the Result.
 
     Parameters
     ----------
     path : str or os.PathLike
-        ``.fold``, or ``.obj``/``.stl`` with a hinge file (``hinges``, default
-        PATH.hinges).
-    thickness : float, optional
-        Sheet thickness H, mm (default: the file's ``foldcore:thickness``).
-    hinge_width : float, optional
-        Hinge width W of every crease, mm (default: the file's, else Eq. 7).
-    subdivisions : int or "auto"
-    fold_percent : float
-        Every target angle × this / 100, in [−100, 100].
-    solver, tolerance, max_iterations, hinge, actuation, branch_floor
-        As :class:`foldcore.Simulation` and its ``run`` (``branch_floor``: degrees).
-    mv_passive, trust_assignment, scale, sheet_size
-        How the file is read (:class:`foldcore.io.Reading`; ``sheet_size``: mm).
-    elastic_cells : float, optional
-        Elastic panels: every face cut into rings of cells about this long, mm
-        (``thicken(elastic="facets", cell_size=...)``), so panels bend and
-        stretch where the targets ask for it; default rigid panels. ``hybrid``
-        folds such a mesh from rest with rigid panels first, then finishes with
-        ``newton`` (:mod:`foldcore.strategies.hybrid`).
-    output, report, render, animate : path, optional
-        Result FOLD, JSON report, PNG render, GIF/MP4 of the sweep from 0 to
-        ``fold_percent`` in ``frames`` frames at ``fps`` (the last frame's run is
-        the result).
-    series : path, optional
-        The same sweep as one FOLD file, a frame per fold percent (achieved angles
-        and the folded solid, :func:`foldcore.outputs.series_frame`).
+        ``.fold``, ``.svg``, or ``.obj``/``.stl`` with a hinge file.
+    hinges : path, optional
+        Hinge file of an OBJ/STL pattern (default: PATH.hinges).
+    reading : foldcore.io.Reading or dict, optional
+        How the file is read (conventions, scaling; :mod:`foldcore.io.conventions`).
+    thickening : foldcore.options.Thickening or dict, optional
+        Thickness, hinge widths and models, sub-strips, elastic cells (mm).
+    solving : foldcore.options.Solving or dict, optional
+        Fold percent, strategy, tolerance, budget, actuation, branch floor.
+    outputs : foldcore.options.Outputs or dict, optional
+        Result FOLD, JSON report, PNG render, animation, series (paths; checked
+        before any work, written all or nothing).
     callback : callable(sim, moved_mm) -> bool or None, optional
         Called after each iteration (:meth:`Simulation.run`); False stops the run.
 
@@ -126,121 +106,146 @@ def simulate(path, *, thickness: float | None = None, hinge_width: float | None 
 
     Raises
     ------
+    OptionError
+        An option outside what it accepts (named ``group.field``).
     Interrupted
         Ctrl-C (KeyboardInterrupt) during the run: the last iterate is written to
         the outputs asked for, marked partial, then this is raised (a
         KeyboardInterrupt). A second Ctrl-C while writing leaves no file.
     """
-    return fold(path, **{k: v for k, v in locals().items() if k != "path"}).result
+    return fold(path, hinges=hinges, reading=reading, thickening=thickening, solving=solving,
+                outputs=outputs, callback=callback).result
 
 
-def fold(path, **options) -> Fold:
+@dataclass(frozen=True)
+class Job:
+    """One fold's inputs: the pattern file, its hinge file, the four option groups."""
+
+    source: str
+    hinges: object
+    reading: object
+    thickening: object
+    solving: object
+    outputs: object
+
+    @classmethod
+    def make(cls, path, hinges=None, reading=None, thickening=None, solving=None,
+             outputs=None) -> "Job":
+        """The groups checked (dicts made groups; OptionError naming ``group.field``)."""
+        import os
+
+        from .io import Reading
+        from .options import Outputs, Solving, Thickening, as_group
+
+        return cls(os.fspath(path), hinges, as_group(Reading, reading, "reading"),
+                   as_group(Thickening, thickening, "thickening"),
+                   as_group(Solving, solving, "solving"),
+                   as_group(Outputs, outputs, "outputs"))
+
+
+def fold(path, *, hinges=None, reading=None, thickening=None, solving=None, outputs=None,
+         callback=None) -> Fold:
     """:func:`simulate`, keeping what the command line reports from (a :class:`Fold`)."""
-    import os
-
-    from .destinations import check_destinations
-    from .errors import RunWarning, SimulationError
-    from .io import Reading
-    from .limits import check_inputs
     from .outputs import run_summary, write_result
-    from .simulation import Simulation
-    from .thickening import thicken
 
-    o = _with_defaults(options)
-    source = os.fspath(path)
-    if o["max_iterations"] < 1:
-        raise SimulationError(f"--max-iterations must be ≥ 1, got {o['max_iterations']}")
-    reading = Reading(mv_without_angle="passive" if o["mv_passive"] else "fold",
-                      trust_assignment=o["trust_assignment"], scale=o["scale"],
-                      size=o["sheet_size"])
-    loaded = load(source, hinges=o["hinges"], reading=reading)
-    check_inputs(loaded.pattern, o["thickness"], o["hinge_width"], loaded.stiffness)
-    thickness = o["thickness"] or loaded.thickness
-    if thickness is None:
-        raise SimulationError(f"{source}: no thickness: pass --thickness H (mm) "
-                              "or set foldcore:thickness in the file")
-    check_destinations({"-o": o["output"], "--report": o["report"], "--render": o["render"],
-                        "--animate": o["animate"], "--series": o["series"]},
-                       inputs=(source, o["hinges"]),
-                       suffixes={"--render": (".png",), "--series": (".fold",)})
-    if o["animate"]:  # (an animation interrupted writes nothing: its frames are a sweep)
-        from .animate import check_output
-        check_output(o["animate"])          # a missing encoder fails before any work
-    cells = o["elastic_cells"]
-    mesh = thicken(loaded.pattern, thickness, o["hinge_width"], o["subdivisions"],
-                   hinge=o["hinge"] or loaded.hinge, stiffness=loaded.stiffness,
-                   elastic="facets" if cells else None, cell_size=cells)
-    sim = Simulation(mesh, loaded.pattern, solver=o["solver"], actuation=o["actuation"],
-                     branch_floor_deg=o["branch_floor"])
+    job = Job.make(path, hinges, reading, thickening, solving, outputs)
+    loaded, thickness = _prepared(job)
+    mesh, sim = _simulation(job, loaded, thickness)
+    out, s = job.outputs, job.solving
     interrupted, sweep = False, None
-    if o["animate"]:
-        sweep = _animate(sim, o)
-    elif o["series"]:
-        sweep = _sweep(sim, o)
+    if out.animate:
+        sweep = _animate(sim, s, out)
+    elif out.series:
+        sweep = _sweep(sim, s, out)
     if sweep is not None:
         result = sweep[-1][1]
     else:
-        sim.set_fold_percent(o["fold_percent"])
+        sim.set_fold_percent(s.fold_percent)
         try:
-            result = sim.run(tolerance=o["tolerance"], max_iterations=o["max_iterations"],
-                             callback=o["callback"])
+            result = sim.run(tolerance=s.tolerance, max_iterations=s.max_iterations,
+                             callback=callback)
         except KeyboardInterrupt:  # the last complete iterate is a result too
             result, interrupted = sim.result(False, "interrupted"), True
-    summary, said = run_summary(result, loaded.pattern, source, o["fold_percent"],
+    summary, said = run_summary(result, loaded.pattern, job.source, s.fold_percent,
                                 elastic=bool(mesh.elastic))
     for text in said:
         warnings.warn(text, RunWarning, stacklevel=3)
-    settings = {"pattern": source, **{k: o[k] for k in ("fold_percent", "solver", "tolerance",
-                                                        "max_iterations", "subdivisions")}}
-    settings.update(thickness_mm=thickness, hinge=sorted(set(mesh.hinge_model) - {""}),
-                    actuation=o["actuation"], branch_floor_deg=o["branch_floor"],
-                    elastic_cells_mm=cells,
-                    backend=sim.system.backend)
-    outputs = {"-o": o["output"], "--report": o["report"], "--render": o["render"]}
-    write_result(result, loaded.pattern, mesh, thickness, settings, fold=o["output"],
-                 report=o["report"], png=o["render"], partial=interrupted,
-                 series=o["series"], sweep=sweep)
+    settings = _settings(job, thickness, mesh, sim)
+    write_result(result, loaded.pattern, mesh, thickness, settings, fold=out.fold,
+                 report=out.report, png=out.render, partial=interrupted,
+                 series=out.series, sweep=sweep)
     if interrupted:
-        raise Interrupted(result, {k: v for k, v in outputs.items() if v})
+        written = {k: v for k, v in out.paths().items()
+                   if v and k in ("outputs.fold", "outputs.report", "outputs.render")}
+        raise Interrupted(result, written)
     return Fold(loaded.pattern, mesh, sim, result, settings, summary)
 
 
-def defaults() -> dict:
-    """:func:`simulate`'s options (its keyword-only parameters) and their defaults; the
-    command line passes its own arguments of these names."""
-    import inspect
+def _prepared(job: Job):
+    """The pattern read and its thickness (mm), every output path checked: all that can
+    fail on the inputs fails here, before any work."""
+    from .destinations import check_destinations
+    from .limits import check_inputs
 
-    return {name: p.default for name, p in inspect.signature(simulate).parameters.items()
-            if p.kind is p.KEYWORD_ONLY}
+    t = job.thickening
+    loaded = load(job.source, hinges=job.hinges, reading=job.reading)
+    check_inputs(loaded.pattern, t.thickness, t.hinge_width, loaded.stiffness)
+    thickness = t.thickness or loaded.thickness
+    if thickness is None:
+        raise OptionError(f"{job.source}: no thickness: give thickening.thickness (mm) "
+                          "or set foldcore:thickness in the file")
+    check_destinations(job.outputs.paths(), inputs=(job.source, job.hinges),
+                       suffixes={"outputs.render": (".png",), "outputs.series": (".fold",)})
+    if job.outputs.animate:  # (an animation interrupted writes nothing: its frames are a sweep)
+        from .animate import check_output
+        check_output(job.outputs.animate)  # a missing encoder fails before any work
+    return loaded, thickness
 
 
-def _with_defaults(options: dict) -> dict:
-    """``options`` over :func:`simulate`'s defaults; an unknown name is a TypeError."""
-    known = defaults()
-    unknown = set(options) - set(known)
-    if unknown:
-        raise TypeError(f"simulate() got unexpected options {sorted(unknown)}")
-    return {**known, **options}
+def _simulation(job: Job, loaded, thickness: float):
+    """(mesh, Simulation) of the job's pattern."""
+    from .simulation import Simulation
+    from .thickening import thicken
+
+    t, s = job.thickening, job.solving
+    cells = t.elastic_cells
+    mesh = thicken(loaded.pattern, thickness, t.hinge_width, t.subdivisions,
+                   hinge=t.hinge or loaded.hinge, stiffness=loaded.stiffness,
+                   elastic="facets" if cells else None, cell_size=cells)
+    sim = Simulation(mesh, loaded.pattern, solver=s.solver, actuation=s.actuation,
+                     branch_floor_deg=s.branch_floor, options=s.strategy_options)
+    return mesh, sim
 
 
-def _animate(sim, o: dict) -> list:
+def _settings(job: Job, thickness: float, mesh, sim) -> dict:
+    """What the report records of the run's settings."""
+    s, t = job.solving, job.thickening
+    return {"pattern": job.source, "fold_percent": s.fold_percent, "solver": s.solver,
+            "tolerance": s.tolerance, "max_iterations": s.max_iterations,
+            "subdivisions": t.subdivisions, "thickness_mm": thickness,
+            "hinge": sorted(set(mesh.hinge_model) - {""}), "actuation": s.actuation,
+            "branch_floor_deg": s.branch_floor, "elastic_cells_mm": t.elastic_cells,
+            "backend": sim.system.backend}
+
+
+def _animate(sim, s, out) -> list:
     """Fold ``sim`` from 0 to the fold percent in ``frames`` steps, write the movie;
     [(percent, Result)] of every frame (:func:`_said_unconverged`)."""
     from .animate import animate, percent_schedule
 
-    percents = percent_schedule(o["frames"], o["fold_percent"])
-    movie = animate(sim, percents, o["animate"], fps=o["fps"], tolerance=o["tolerance"],
-                    max_iterations=o["max_iterations"])
+    percents = percent_schedule(out.frames, s.fold_percent)
+    movie = animate(sim, percents, out.animate, fps=out.fps, tolerance=s.tolerance,
+                    max_iterations=s.max_iterations)
     return _said_unconverged(list(zip(map(float, percents), movie.results)))
 
 
-def _sweep(sim, o: dict) -> list:
-    """:func:`_animate` without the pictures (``--series`` alone)."""
+def _sweep(sim, s, out) -> list:
+    """:func:`_animate` without the pictures (a series alone)."""
     from .animate import fold_sweep, percent_schedule
 
-    percents = percent_schedule(o["frames"], o["fold_percent"])
-    results = fold_sweep(sim, percents, tolerance=o["tolerance"],
-                         max_iterations=o["max_iterations"], progress=False)
+    percents = percent_schedule(out.frames, s.fold_percent)
+    results = fold_sweep(sim, percents, tolerance=s.tolerance,
+                         max_iterations=s.max_iterations, progress=False)
     return _said_unconverged(list(zip(map(float, percents), results)))
 
 

@@ -8,6 +8,7 @@ positions, degrees for angles.
 """
 from __future__ import annotations
 
+import logging
 import time
 
 import numba
@@ -23,6 +24,8 @@ from .model import Model
 from .result import Result
 from .strategies import DEFAULT_SOLVER
 from .threads import BLAS_GUARD_FROM, ThreadChooser, blas_on_one_thread, choose_threads
+
+log = logging.getLogger(__name__)
 
 #: Degrees on its assigned side every passive M/V crease must be for a sheet within
 #: the branch floor to count as having left flat on its branch (no branch stage).
@@ -273,6 +276,8 @@ class Simulation:
         budget, limit = int(max_iterations), tolerance * self.model.length_scale
         reason = "budget"  # unless the (released) stage ends otherwise
         self.convergence.begin_run()
+        log.info("run %d: %s, fold percent %g, tolerance %g, budget %d", self.progress.runs,
+                 self.solver, self.model.fold_percent, tolerance, budget)
         with blas_on_one_thread(self._guard_blas):
             try:
                 branch_stage = self._starts_flat()
@@ -292,7 +297,11 @@ class Simulation:
         self.timings["total"] += time.perf_counter() - start
         if self.model.system.factored:  # a rigid-body run never needs K
             self.timings["bare_solve"] = self._bare_solve_floor()
-        return self.result(reason == "converged", reason)
+        result = self.result(reason == "converged", reason)
+        log.info("run %d ended %s after %d iterations (residual %.2g, %.3g s)",
+                 self.progress.runs, reason, result.iterations, result.residual,
+                 time.perf_counter() - start)
+        return result
 
     def _stage(self, budget: int, callback, limit: float) -> tuple[int, str]:
         """One bracketed stretch of strategy steps; returns (steps taken, reason)."""
@@ -348,12 +357,15 @@ class Simulation:
         model = self.model
         floor = model.passive_floor_deg
         model.set_floor(max(floor, self.branch_floor_deg))
+        log.info("branch stage: passive M/V creases held %g° on their assigned side",
+                 self.branch_floor_deg)
         try:
             result = self._stage(budget, callback,
                                  max(limit, BRANCH_TOLERANCE * model.length_scale))
         finally:
             model.set_floor(floor)
         self.branch_iterations += result[0]
+        log.info("branch stage ended %s after %d steps; floor released", result[1], result[0])
         return result
 
     def _bare_solve_floor(self) -> float:

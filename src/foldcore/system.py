@@ -8,6 +8,7 @@ through a vertex→slot CSR (each vertex sums its own slots: no races).
 """
 from __future__ import annotations
 
+import logging
 import math
 from pathlib import Path
 
@@ -20,6 +21,8 @@ from elements._cache import choose_cache_dir
 from .linsolve import Factor, resolved_backend
 
 choose_cache_dir(Path(__file__))  # before this module's cache=True kernels (read-only installs)
+
+log = logging.getLogger(__name__)
 
 TAKE_CHUNKS = 64  # blocks of vertices :func:`take_solution` splits among threads
 
@@ -165,6 +168,7 @@ class System:
         Miura 50 × 50 (88 796 vertices, nnz(L) 2.0 M) it was 75 MB of the fold's
         memory (RSS), and the coarse twin's Simulation factorised its own."""
         if self._factor is None:
+            log.debug("K factorised: %d rows (%s)", self.n_vertices, self.backend)
             self._factor = Factor(self.with_pins(), self.backend)
         return self._factor
 
@@ -210,6 +214,7 @@ class System:
 
     def _refactor(self) -> None:
         if self._factor is not None:  # else the first use factorises the new K
+            log.debug("K refactorised: its weights or pins changed")
             self._factor.refactor(self.with_pins())
         self.version += 1
 

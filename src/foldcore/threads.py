@@ -31,11 +31,14 @@ inherited by child processes.
 """
 from __future__ import annotations
 
+import logging
 import threading
 from contextlib import contextmanager, nullcontext
 from statistics import median_low
 
 import numpy as np
+
+log = logging.getLogger(__name__)
 
 # threadpoolctl.ThreadpoolController, built on first use: by then a Simulation
 # exists, and building one loads numpy's and scipy's BLAS (checked)
@@ -144,10 +147,11 @@ class ThreadChooser:
         del times[:-self.WINDOW]
         if self._probing is not None:  # back off while the probed count stays slower
             lost = self.best() != self._probing
+            log.debug("threads: a step on %d thread(s) was %s; %d run the next steps",
+                      self._probing, "slower" if lost else "faster", self.best())
             self._interval = min(2 * self._interval, self.EXPLORE_MOST) if lost \
                 else self.EXPLORE_EVERY
             self._until, self._probing = self._interval, None
-
 
 
 #: Element-vertex slots below which a simulation's kernels run on one thread (a

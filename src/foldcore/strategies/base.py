@@ -7,7 +7,12 @@ from dataclasses import dataclass
 from ..convergence import Report
 
 SOLVERS = ("paper", "anderson", "lbfgs", "rigid", "hybrid", "newton")
-_BUILTIN_MODULES = {name: f"foldcore.strategies.{name}" for name in SOLVERS}
+_BUILTIN_MODULES = {"paper": "foldcore.strategies.paper",
+                    "anderson": "foldcore.strategies.anderson",
+                    "lbfgs": "foldcore.strategies.lbfgs",
+                    "rigid": "foldcore.strategies.rigid",
+                    "hybrid": "foldcore.strategies.hybrid",
+                    "newton": "foldcore.strategies.newton"}
 _REGISTRY: dict[str, type] = {}
 
 

@@ -17,6 +17,7 @@ L-BFGS. Why this composite: `docs/design.md#the-default-strategy`.
 """
 from __future__ import annotations
 
+import logging
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -28,6 +29,9 @@ from ..lbfgs import Lbfgs, LbfgsOptions
 from ..newton import Newton, NewtonOptions
 from ..rigid import Rigid, RigidOptions, at_rest
 from .rings import RigidStart, in_rings, rigid_twin_mesh
+
+
+log = logging.getLogger(__name__)
 
 
 @dataclass(frozen=True)
@@ -126,12 +130,15 @@ class Hybrid(Strategy):
             return
         mesh = rigid_twin_mesh(model.mesh, model.pattern)
         if mesh is not None:
+            log.info("hybrid: the rigid-panel twin steps first, then %s on the cells",
+                     self.finish.name)
             self._start = RigidStart(model, self.progress, mesh, self.options.rigid)
             self._start.begin()
 
     def _end_rigid_start(self) -> None:
         """The cells take the rigid twin's state; the finishing strategy goes on."""
         start, self._start = self._start, None
+        log.info("hybrid: the cells take the rigid twin's state after %d steps", start.steps)
         self.model.x = np.ascontiguousarray(start.positions())
         self.finish.restart()
 
@@ -178,6 +185,8 @@ class Hybrid(Strategy):
                 self.rigid.hand_over()
                 self.rigid.engine.forget_ends()
                 self._finish_with_newton()
+                log.info("hybrid: rigid phase ends unsettled after %d steps; %s finishes",
+                         self._rigid_steps, self.finish.name)
             self._leave_rigid_phase()
         return done
 

@@ -13,6 +13,7 @@ and updates λ by the gain ratio (Nielsen's rule). Why each part:
 """
 from __future__ import annotations
 
+import logging
 import time
 
 import numpy as np
@@ -20,6 +21,8 @@ import scipy.sparse as sp
 
 from ...linsolve import Factor
 from .residual import ROUNDING
+
+log = logging.getLogger(__name__)
 
 BOUND_TOL = 1e-12  # rad: a bounded angle this close to its bound is on it
 
@@ -247,6 +250,8 @@ class LevenbergMarquardt:
         n = lay.n_unknowns
         matrix = sp.csc_matrix((normal, lay.csc_indices, lay.csc_indptr), shape=(n, n))
         if self.factor is None or self._pattern != lay.version:
+            log.debug("rigid: normal matrix analysed and factorised (%d unknowns, %d entries)",
+                      n, len(normal))
             self.factor = Factor(matrix, engine.backend, stored="lower")
             self._pattern = lay.version
         else:

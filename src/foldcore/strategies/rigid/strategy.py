@@ -19,6 +19,7 @@ kept twin again. Why: `docs/design.md#the-coarse-twin`.
 """
 from __future__ import annotations
 
+import logging
 import time
 
 import numpy as np
@@ -28,6 +29,9 @@ from ...errors import SimulationError
 from ..base import Strategy
 from .engine import RigidBodySolver
 from .options import RigidOptions
+
+
+log = logging.getLogger(__name__)
 
 
 def at_rest(model, x: np.ndarray, tolerance: float) -> bool:
@@ -99,6 +103,8 @@ class Rigid(Strategy):
             if (continues or self._at_rest()) and self._coarse_twin() is not None:
                 self.twin = self._twin
                 self.twin.engine.new_run()
+                log.info("rigid: the run steps the coarse twin first (%d strips for %d)",
+                         len(self.twin.engine.layout.ids), len(self.engine.layout.ids))
         if self.twin is not None:
             self.twin.mirror(self.model, self.progress)  # this stage's targets and floors
 
@@ -139,6 +145,7 @@ class Rigid(Strategy):
         if self.twin is None:
             return
         t0 = time.perf_counter()
+        log.info("rigid: the coarse twin hands over to the mesh's own engine")
         self.twin.hand_over(self.engine)
         self.twin = None
         if not keep:
