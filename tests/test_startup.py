@@ -123,7 +123,7 @@ def test_openmp_threads_wait_passively_unless_the_user_chose():
     """``import foldcore`` sets OMP_WAIT_POLICY=PASSIVE before anything loads GNU
     OpenMP, and the libgomp a simulation runs on took it: its own report shows
     no spinning (GOMP_SPINCOUNT 0; unset, 300 000 polls). A value the user set
-    is kept (ACTIVE: far more). Why: issue 17, ``bench/load.py``."""
+    is kept (ACTIVE: far more). Why: ``bench/load.py``."""
     env = {k: v for k, v in os.environ.items()
            if k not in ("OMP_WAIT_POLICY", "GOMP_SPINCOUNT")}
     assert _gomp_spin_count(env) == (False, [0])
