@@ -76,7 +76,7 @@ def test_warmup_compiles_what_a_first_simulate_needs(tmp_path):
     """After ``python -m foldcore.warmup`` (the set-up's last step), a default
     ``foldcore simulate`` of a hinge in a new process compiles no kernel. Both
     run on an empty numba cache of their own (NUMBA_CACHE_DIR), so the project's
-    warm cache cannot hide a kernel the warm-up misses (cold: ~20 s)."""
+    warm cache cannot hide a kernel the warm-up misses (slow: a cold compile)."""
     env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "numba")}
     subprocess.run([sys.executable, "-m", "foldcore.warmup"], capture_output=True,
                    timeout=600, check=True, env=env)

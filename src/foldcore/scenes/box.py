@@ -4,10 +4,9 @@ Provenance. The paper folds "the five-crease multiple-vertex origami used by
 Chen et al. [4] to make boxes (Fig. 2 of their paper)": six vertices, five
 hinges at each; folded, "the two panels adjacent to the mountain-fold hinge
 are put together and protrude in the inside volume". Chen, Peng & You's
-pattern (Science 2015, Fig. 2) is **not available here** (a search of the
-stored pages, docs and code found only the paper's abstract), so this
-scene uses a **reconstruction** from that description, not the source
-pattern: a hexagonal tray (:func:`hexagonal_tray`) —
+pattern (Science 2015, Fig. 2) is **not available here**, so this scene
+uses a **reconstruction** from that description, not the source pattern: a
+hexagonal tray (:func:`hexagonal_tray`) —
 
 * bottom: a regular hexagon of side ``SIDE`` = 50 mm;
 * six rectangular walls ``SIDE`` × ``HEIGHT`` (25 mm) hinged on its edges;
