@@ -1,4 +1,4 @@
-"""A 3 × 3 Miura sheet with rigid panels and with elastic plates (issue 6, beyond §5.5).
+"""A 3 × 3 Miura sheet with rigid panels and with elastic plates (beyond paper §5.5).
 
 Every crease is driven to its zero-thickness rigid-fold angle at facet tilt
 30° (a = b = 20 mm, γ = 60°, H = 1 mm, W = 2 mm, k = 2), with rigid panels

@@ -1,4 +1,4 @@
-"""A 2D elastic plate twists where a bar of the same cells cannot (issue 6, beyond §5.5).
+"""A 2D elastic plate twists where a bar of the same cells cannot (beyond paper §5.5).
 
 A square panel (40 × 40 mm, H = 1 mm) hangs on a hinge (W = 2 mm, passive)
 from a held panel. Its far corner at y = 0 is pulled 10 mm up while the far

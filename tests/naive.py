@@ -1,7 +1,8 @@
 """Slow, obviously-correct NumPy twins of every element kernel (STUMPY style).
 
-Written from the equations (paper §4, DESIGN.md), not from the numba code: the
-tests compare each registered kernel against the twin of the same name.
+Written from the equations (paper §4, the element modules' docstrings), not from
+the numba code: the tests compare each registered kernel against the twin of the
+same name.
 Units: mm, radians.
 """
 import numpy as np
@@ -225,7 +226,7 @@ def project_group(etype_name, x, group_like, params=None):
 
 
 # ------------------------------------------------- planar graphs (planar.py's twins)
-# The one-item-at-a-time versions foldcore.planar used before it was vectorised.
+# One-item-at-a-time reference versions of foldcore.planar's vectorised functions.
 def trace_faces(vertices, edges):
     """Face cycles by walking each directed edge once (the face on its left)."""
     nbrs = [[] for _ in range(len(vertices))]

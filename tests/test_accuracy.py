@@ -1,4 +1,4 @@
-"""Accuracy against the closed forms of kinematics.md, from the CLI defaults (issue 16).
+"""Accuracy against the closed forms of :mod:`foldcore.kinematics`, from the CLI defaults.
 
 Every case is folded by ``foldcore simulate PATTERN.fold --thickness H -o OUT.fold``
 with no other option — default hinge model (axis), actuation (equal weights),
@@ -6,12 +6,12 @@ branch stage, strategy (hybrid), subdivisions (auto), tolerance (1e-8) — and
 the achieved angles read back from the written file, so what a user of the
 command line gets is what is held to the closed form.
 
-Bound: 0.01° per crease, the issue's. Why the thick model can meet it: the
+Bound: 0.01° per crease. Why the thick model can meet it: the
 axis hinge turns a crease's two panels about the crease's mid-line, so the
 hinges around a vertex meet at it and a rigid-foldable pattern folds without
 strain at any thickness (:mod:`foldcore.hinges`); what is left is the
 iteration's stopping tolerance (measured errors 1e-10…5e-7°, bench/accuracy).
-Sizes: H/R = 1e-3 and W = 3H for the vertices, as the issue states; thin
+Sizes: H/R = 1e-3 and W = 3H for the vertices; thin
 Miura H = 1e-3·a (5 × 5: W = 3H, 10 × 10: W = H); thick Miura H = 0.1·a,
 W = H, folded to facet tilt 30° (zig-zag 60°, straight 32.2°: its panels
 clear each other).

@@ -1,4 +1,4 @@
-"""Reading files made for Origami Simulator (issue 19, item 1): M/V without angles,
+"""Reading files made for Origami Simulator: M/V without angles,
 sheets in any plane, folded forms, scaling, and angles against their assignment."""
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Thick Miura folded flat: the layers a degree-4 vertex stacks (issue 17).
+"""Thick Miura folded flat: the layers a degree-4 vertex stacks.
 
 Flat, a degree-4 vertex stacks its four panels in four layers, and the crease
 opposite its odd crease (M/V unlike the other three) wraps around the other

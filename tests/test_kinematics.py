@@ -1,4 +1,4 @@
-"""Zero-thickness closed forms (reference/kinematics.md) against the closure oracle."""
+"""Zero-thickness closed forms of :mod:`foldcore.kinematics` against its closure oracle."""
 import numpy as np
 import pytest
 

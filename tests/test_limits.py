@@ -1,8 +1,8 @@
-"""Range limits (issue 18, item 2): numbers outside :mod:`foldcore.limits` are refused
-with one line naming the file and the item; the corners inside the window fold.
+"""Range limits: numbers outside :mod:`foldcore.limits` are refused with one line
+naming the file and the item; the corners inside the window fold.
 
-Reproducers of the audit: each was a traceback (SVD did not converge, CHOLMOD
-not positive definite) or a message naming no file.
+``REPRODUCERS`` are inputs that would otherwise end in a traceback (SVD did not
+converge, CHOLMOD not positive definite) or a message naming no file.
 """
 from __future__ import annotations
 
@@ -91,7 +91,7 @@ def test_out_of_range_exits_2_with_one_line_and_no_output(name, scene, capsys):
 
 
 def test_non_finite_iteration_names_the_pattern(scene, capsys, monkeypatch):
-    """Before: "the iteration produced non-finite positions", naming no file."""
+    """A non-finite iteration is reported with the pattern's file name."""
     monkeypatch.setattr(Simulation, "_step", lambda self: float("nan"))
     out = scene / "out.fold"
     code = main(["simulate", str(scene / "hinge.fold"), "-o", str(out)])

@@ -33,7 +33,7 @@ def test_best_rotations_of_reflected_covariances_are_proper_and_optimal():
              for _ in range(2)]
     covs = np.array(reflected + plain)
     u, _, vt = np.linalg.svd(covs[:4])
-    assert np.all(np.linalg.det(u @ vt) < 0)   # the case the fix is for
+    assert np.all(np.linalg.det(u @ vt) < 0)   # the case under test
     rotations = best_rotations(covs.copy())
     # rounding only: orthonormal products of 3 × 3 factors of norm ≤ 3
     assert np.allclose(np.linalg.det(rotations), 1.0, atol=1e-12)

@@ -1,9 +1,9 @@
-"""Reading at scale (issue 18.5): the vectorised checks equal the one-by-one ones.
+"""Reading at scale: the vectorised checks equal the one-by-one ones.
 
-The planar helpers are compared with their twins in ``tests/naive.py`` (the
-code foldcore used before), the FOLD reader's at-once paths with its
-row-by-row paths, and a 10⁵-vertex grid is read (its speed is measured in
-bench/reading.py, not here).
+The planar helpers are compared with their one-by-one twins in
+``tests/naive.py``, the FOLD reader's at-once paths with its row-by-row paths,
+and a 10⁵-vertex grid is read (its speed is measured in bench/reading.py, not
+here).
 """
 import json
 import warnings

@@ -1,4 +1,4 @@
-"""A read-only install without a writable home still runs (issue 18, item 4).
+"""A read-only install without a writable home still runs.
 
 numba's ``cache=True`` raises ``no locator available`` at the decorator when
 neither ``NUMBA_CACHE_DIR``, the in-tree ``__pycache__`` nor ``~/.cache/numba``
@@ -78,7 +78,7 @@ def test_the_copy_is_really_read_only_for_the_child(install):
 
 @pytest.mark.slow
 def test_a_read_only_install_folds_a_hinge_caching_in_a_fallback_folder(install):
-    """Cold compile of every kernel the hinge needs (~40-70 s here)."""
+    """Slow: compiles every kernel the hinge needs from cold."""
     site, tmp = install
     proc = run_child(site, tmp, FOLD_HINGE)
     assert proc.returncode == 0, proc.stderr

@@ -1,4 +1,4 @@
-"""The acceptance corpus (issue 19, item 8): public crease patterns nobody here wrote
+"""The acceptance corpus: public crease patterns written outside this project
 (``tests/data/real/``, sources and licences in its SOURCES.md), read and folded as
 a new user would — through :func:`foldcore.simulate`, Origami Simulator's
 conventions, the sheet scaled to 100 mm, H = 0.5 mm, the default strategy.
@@ -109,8 +109,8 @@ def test_a_file_that_writes_magnitudes_only_folds_with_trust_assignment():
 
 
 def test_origami_simulators_own_export_in_the_xz_plane_reads():
-    """Pleating/BoxPleatPyramid.fold: a flat sheet at y = 0 labelled foldedForm; it was
-    refused (z = -0.707) before sheets in any plane were rotated into z = 0."""
+    """Pleating/BoxPleatPyramid.fold: a flat sheet at y = 0 labelled foldedForm (not
+    in z = 0: z = -0.707) is rotated into z = 0 and read."""
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         pattern = foldcore.read(REAL / "BoxPleatPyramid.fold")

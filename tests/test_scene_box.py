@@ -10,7 +10,7 @@ Tolerances and why:
   not fold through itself; 0.1° slack as in tests/test_scenes.py (a strip
   held at its bound, measured from the panels).
 * "A box": walls rise by more than 60° (the rim stands at ≥ sin 60° = 87 % of
-  the wall height; measured ≈ 81° and 74°), the gusset fins sit inside the
+  the wall height), the gusset fins sit inside the
   corners (> 0 mm inward; a fin folded outward would be < 0).
 * Thickness: the corner mismatch grows with W against the panels, so the
   4 mm box flares more and keeps a smaller fraction of the thin tray's

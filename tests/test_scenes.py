@@ -101,7 +101,7 @@ def test_chain_shortens_along_as_it_is_pushed_across_then_stops(runs):
         assert b["longitudinal_mm"] < a["longitudinal_mm"]
     # the zig-zag hinges stop at flat (their panels do not fold past it: 0.01°), and
     # with them the chain's shortening along (less than a quarter of its smallest
-    # step while moving; measured 0.08); across it still gives (module docstring)
+    # step while moving); across it still gives (module docstring)
     along = min(a["longitudinal_mm"] - b["longitudinal_mm"] for a, b in zip(moving, moving[1:]))
     for a, b in zip(stopped, stopped[1:]):
         assert b["max_zigzag_deg"] <= 180.0 + 0.01
@@ -129,7 +129,7 @@ def test_hinge_study_radius(runs):
 
 def test_groove_bar_hinge_stops_at_its_limit_then_the_panels_bend(runs):
     """Up to 90° the pull is exactly reachable by the hinge (its model's kinematics), so
-    the panels stay rigid (deviation ≤ 1e-6 of their length, the issue's bound) and
+    the panels stay rigid (deviation ≤ 1e-6 of their length) and
     the hinge follows the pull; beyond it the hinge's stop holds it at 90° ± 0.5°
     (its weight ×1000, finite) and the panels' bend grows with every step."""
     steps = runs["groove-bar"].quantities["steps"]
@@ -179,8 +179,7 @@ def test_cli_scene_writes_outputs_and_refuses_bad_input(tmp_path, capsys):
 
 
 def test_the_hinge_study_picture_shows_every_run(runs, tmp_path):
-    """It showed 1 of its 18 runs (issue 19): now a tile per (hinge model, W, k), each
-    titled with its achieved angle."""
+    """A tile per (hinge model, W, k) run, each titled with its achieved angle."""
     import imageio.v3 as iio
 
     scene = runs["hinge-study"]

@@ -76,7 +76,7 @@ def test_warmup_compiles_what_a_first_simulate_needs(tmp_path):
     """After ``python -m foldcore.warmup`` (the set-up's last step), a default
     ``foldcore simulate`` of a hinge in a new process compiles no kernel. Both
     run on an empty numba cache of their own (NUMBA_CACHE_DIR), so the project's
-    warm cache cannot hide a kernel the warm-up misses (cold: ~20 s)."""
+    warm cache cannot hide a kernel the warm-up misses (slow: a cold compile)."""
     env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path / "numba")}
     subprocess.run([sys.executable, "-m", "foldcore.warmup"], capture_output=True,
                    timeout=600, check=True, env=env)
@@ -123,7 +123,7 @@ def test_openmp_threads_wait_passively_unless_the_user_chose():
     """``import foldcore`` sets OMP_WAIT_POLICY=PASSIVE before anything loads GNU
     OpenMP, and the libgomp a simulation runs on took it: its own report shows
     no spinning (GOMP_SPINCOUNT 0; unset, 300 000 polls). A value the user set
-    is kept (ACTIVE: far more). Why: issue 17, ``bench/load.py``."""
+    is kept (ACTIVE: far more). Why: ``bench/load.py``."""
     env = {k: v for k, v in os.environ.items()
            if k not in ("OMP_WAIT_POLICY", "GOMP_SPINCOUNT")}
     assert _gomp_spin_count(env) == (False, [0])

@@ -4,9 +4,7 @@ numba's ``cache=True`` keys each compiled function on its *own* source file
 (modification time and size). A kernel that calls a helper from another
 module — every element type calls :func:`elements._rotation.fit_rotated` —
 keeps running the helper it was compiled with after the helper's file
-changes. Measured here: after the scaled-Newton polar factor replaced the
-per-element SVD in ``_rotation.py``, ``rigid_panel``'s cached batch still ran
-the SVD, 3.1 µs per panel instead of 0.39 µs (Miura 40 × 40, one thread).
+changes (docs/design.md#stale-kernels-after-a-helper-changes).
 
 The guard: a stamp (SHA-256 of the package's ``*.py`` sources and the numba
 version) is kept beside numba's cache files; when it differs at import, every

@@ -2,8 +2,7 @@
 
 The fit is allocation-free: the centroid, the 3×3 covariance A and the rotation
 live in scalars (numba keeps them in registers), because a per-element
-``np.linalg.svd`` with its small arrays cost ~4 µs and dominated the whole
-projection (measured on Miura 40×40: 3–3.6 µs per element).
+``np.linalg.svd`` with its small arrays dominated the whole projection.
 
 The rotation maximising tr(Rᵀ A) is found as Horn's unit quaternion: the
 largest root of the 4×4 key matrix's characteristic polynomial by Newton from
@@ -12,21 +11,17 @@ quaternion-based characteristic polynomial"), its eigenvector from the
 adjugate, then Newton steps on the rotation itself (one or two; at most
 ``POLISH_MAX``) to bring the eigenvector's error, ε(λ/gap)², to the
 conditioning of the problem, ε·λ/gap (:func:`quaternion_fit`,
-:func:`polish_quaternion`). It always gives a proper
-rotation (det = +1), also for inverted elements. Measured on the hinge kernel
-(Miura 50 × 50, 19 600 strips, one thread): the rotation fit took 7.4 ms with
-the scaled Newton polar iteration X ← ½(γX + X⁻ᵀ/γ) (Higham 1986), which needs
-6–7 iterations per element, and 3.3 ms this way.
+:func:`polish_quaternion`). It always gives a proper rotation (det = +1), also
+for inverted elements, in about half the time of the scaled Newton polar
+iteration (docs/design.md#rotation-fit-of-an-element).
 
 Where the eigen-gap is tiny (nearly collinear or coincident points:
 |κ| < ``GAP_MIN`` λ³, κ = Π(λⱼ − λ)) the Newton polar factor is used instead, and
 where the covariance is inverted or nearly singular (det ≤ ``DEGENERATE``
 ‖A‖³) Horn's quaternion again, its eigenvector found by cyclic Jacobi
 rotations of the 4×4 key matrix (:func:`jacobi_rotation`), which any
-(repeated) eigenvalue leaves well-defined. That rare path used to be
-``np.linalg.svd`` with a det flip, whose numba compilation alone took 3.5 s
-(measured 2026-11-25); a cold first fold of the start-up benchmark's scene
-went 15.7 → 9.0 s with this change.
+(repeated) eigenvalue leaves well-defined; unlike an ``np.linalg.svd``
+fallback it compiles quickly.
 """
 import math
 

@@ -276,10 +276,9 @@ def prepare(indptr, rest, params, shapes):
 
     Local frame, centred, as :func:`batch` makes it: an actuated strip's
     target depends on its parameters only, so the engine computes it here
-    once per change of targets instead of every iteration (Miura 50 × 50,
-    19 600 strips: projection 6.8 → 6.0 ms per iteration on one thread,
-    ~0.04 µs per strip; ``bench/scaling.py --child 50`` before and after).
-    Passive strips' rows are not written.
+    once per change of targets instead of every iteration
+    (docs/design.md#prepared-shapes-of-actuated-strips). Passive strips' rows
+    are not written.
     """
     for e in prange(len(indptr) - 1):
         phi = params[e, TARGET]

@@ -23,7 +23,7 @@ from importlib import import_module
 # Before anything loads GNU OpenMP (numba's "omp" threading layer, CHOLMOD
 # through scikit-sparse): idle OpenMP threads sleep instead of spinning, so a
 # parallel step on a shared machine does not wait a time slice for a thread a
-# spinning sibling displaced (issue 17, bench/load.py; see foldcore.threads).
+# spinning sibling displaced (bench/load.py measures it; see foldcore.threads).
 # A value the user set is kept; libgomp reads it once, when it loads.
 os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
 

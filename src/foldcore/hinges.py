@@ -4,7 +4,8 @@ A crease of width W in a sheet of thickness H becomes k sub-strips, each a
 prism bent by φ (θ = kφ for the crease). Where the panels go is decided by
 the bent shape of the strip's end faces — a modelling choice, and one that
 decides whether thick vertices can fold at all. Three models
-(``thicken(..., hinge=...)``, ``--hinge``, FOLD ``foldcore:edges_hinge``):
+(``thicken(..., hinge=...)``, ``--hinge``, FOLD ``foldcore:edges_hinge``);
+measured figures for each: docs/design.md#hinge-models-in-numbers.
 
 ``"axis"`` (default) — the panels turn about the crease's mid-line.
     The strip is an arc whose neutral axis has the length W·f(θ),
@@ -12,46 +13,32 @@ decides whether thick vertices can fold at all. Three models
     rotation by θ about the crease's mid-line (chord W·cos(θ/2), same
     directions), so the panels move as in rigid origami at any thickness:
     the hinge axes of a vertex meet at the vertex and every rigid-foldable
-    pattern folds without strain. Measured (bench/accuracy,
-    tests/test_accuracy): degree-4 vertices on both branches, a degree-5
-    corner and Miura sheets up to 20 × 20, thin and thick, land within 5e-7°
-    of the closed forms. The price is that the
-    strip shortens as it bends (1 − f: 21 % at 90°), and that f → 0 at 180°,
-    where flat-folded panels would share their mid-line and overlap by H.
+    pattern folds without strain. The price is that the strip shortens as
+    it bends (1 − f: 21 % at 90°), and that f → 0 at 180°, where
+    flat-folded panels would share their mid-line and overlap by H.
     So the neutral axis is never shorter than H·|φ|/2, the length at which
     the strip's inner surface has radius 0: from θ* = 2·atan(W/H) on —
     exactly where the panels' inner edges touch (tan(θ*/2) = W/H) — the
     strip pivots about its inner surface instead, and flat panels stack H
     apart, face to face, without overlapping. Past θ* the panels turn about
-    their touching inner edges, a line off the crease's mid-line (the
-    equivalent axis sits (H/2)·tan(θ/2) from each panel's edge instead of
-    W/2), so a vertex whose creases fold past their θ* binds like the arc
-    model does: the report lists those creases (``hinges.pivoting_edges``)
-    and how far the strips miss their shapes (``hinges.largest_misfit_mm``).
-    Measured: Pehrson's vertex at W/H = 0.3 (θ* = 33°) driven to 70° misses
-    by 2.7°; at the paper's size folded flat it stops at 162/135/161/−135°.
+    their touching inner edges, a line off the crease's mid-line, so a
+    vertex whose creases fold past their θ* binds like the arc model does:
+    the report lists those creases (``hinges.pivoting_edges``) and how far
+    the strips miss their shapes (``hinges.largest_misfit_mm``).
 
     The k sub-strips of a crease are a series: each is shortened for the
     crease's total bend θ (the sum of their angles), not k times its own
     (:func:`elements.bending_hinge.series_bend`). Where they bend alike —
-    actuated creases, and passive creases under the rigid strategy, which
-    bends each as one arc — the crease's end faces are exactly those of the
-    rotation. Passive strips under the local/global strategies estimate
-    their angles one by one and may bend unequally; their composite is then
-    close to, not exactly, the rotation (as for the arc, uniform bending is
-    one of a family of zero-strain distributions when k ≥ 4). Measured: a
-    hinge pulled to 45° by position targets reaches 45.0000002° under
-    ``lbfgs`` with strips at 10.7/12.8/9.6/11.8°; a per-strip rule
-    (f(kφ) of each strip's own φ) instead stalled at 44.65° with two strips
-    flat.
+    actuated creases, and passive creases under the rigid strategy — the
+    crease's end faces are exactly those of the rotation; passive strips
+    under the local/global strategies may bend unequally, and their
+    composite is then close to, not exactly, the rotation.
 
 ``"arc"`` — the paper's hinge (§4, Eq. 7): a circular arc of constant
     neutral-axis length W. It keeps flat panels 2(r + H/2) apart (thickness
     accommodation) but turns the panels about an axis that drifts off the
     crease (≈ W·θ²/12 at small θ, 0.12 W at 70°), so the hinges around a
-    vertex do not meet and every closed loop must strain to fold: Pehrson's
-    vertex, mode A, crease 1 to 70°, ends 0.8/5.4/21/37° short at
-    W/H = 1/3/10/30 (bench/accuracy; the same at any H), mode B 30–110°.
+    vertex do not meet and every closed loop must strain to fold.
 
 ``"eq8"`` — the paper's Eq. 8 trapezoid: the arc's linear approximation
     (end faces sheared, error O(φ²)), with the arc's drift.

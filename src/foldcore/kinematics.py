@@ -1,6 +1,7 @@
 """Zero-thickness rigid-origami closed forms: the ground truth of accuracy tests.
 
-Everything follows ``reference/kinematics.md``. Core functions take and return
+This module is the project's reference for rigid origami: each closed form
+is stated in its function's docstring. Core functions take and return
 **radians**; the ``*_deg`` wrappers take and return degrees. A fold angle ρ is
 the FOLD ``edges_foldAngle`` (deviation from flat, valley > 0, mountain < 0).
 
@@ -18,7 +19,7 @@ panel 0 (before crease 1) fixed, panel k sits at ``R(d_1,ρ_1)···R(d_k,ρ_k)`
 ``d_i`` towards +z: the two panels close over their +z faces, a valley. The
 reversed product with the same signs is the mirror image (z → −z) of this one,
 so closure alone cannot tell valley from mountain; the sign convention above is
-what fixes it. The reference's Pehrson mode-A state (90, 45, 90, −45)° closes.
+what fixes it. Pehrson's mode-A state (90, 45, 90, −45)° closes.
 """
 from __future__ import annotations
 

@@ -23,9 +23,9 @@ def best_rotations(covs: np.ndarray) -> np.ndarray:
 def element_rotations(group, positions: np.ndarray) -> np.ndarray:
     """(n, 3, 3) best-fit rotation of each element's rest shape onto its current shape.
 
-    All elements at once (segment sums over the slots): a Python loop over the
-    panels cost a 200-frame fold-percent path of a Miura 8 × 8 0.8 s of its 8.5 s
-    (two fold-angle measurements per frame)."""
+    All elements at once (segment sums over the slots), because a Python loop over
+    the panels was a tenth of a fold path's time
+    (docs/design.md#panel-rotations-in-one-pass)."""
     starts = group.indptr[:-1]
     sizes = np.diff(group.indptr)
     p = positions[group.indices]

@@ -207,7 +207,7 @@ class CreasePattern:
         n_ok = int(np.argmax(broken)) if broken.any() else len(lengths)
         areas = signed_areas(self.vertices, flat[:int(starts[n_ok]) if n_ok < len(lengths)
                                                else len(flat)], lengths[:n_ok])
-        zero = np.flatnonzero(np.abs(areas) <= 0)  # (as before: a NaN area is not zero)
+        zero = np.flatnonzero(np.abs(areas) <= 0)  # (a NaN area is not zero)
         n_ok = int(zero[0]) if len(zero) else n_ok
         for i in np.flatnonzero(areas[:n_ok] < 0):
             warnings.warn(f"{self.source}: face {i} was clockwise; reversed to "

@@ -3,8 +3,8 @@
 Every generator returns a validated :class:`~foldcore.pattern.CreasePattern`.
 Units at this API: lengths in mm, angles in **degrees** (valley positive).
 Each docstring states the vertex and edge ordering, so creases can be indexed.
-Mountain/valley choices follow ``reference/kinematics.md`` and are checked
-against the closure oracle in :mod:`foldcore.kinematics` by the tests.
+Mountain/valley choices follow the closed forms of :mod:`foldcore.kinematics`
+and are checked against its closure oracle by the tests.
 """
 from __future__ import annotations
 
@@ -45,7 +45,8 @@ def degree4_vertex(sectors=PEHRSON_SECTORS, radius: float = 76.2, widths=PEHRSON
     widths : 4 floats or None, mm
         Hinge width per crease (NaN / None = auto).
     mode : {"A", "B"}
-        Folding branch of kinematics.md that sets M/V: the crease whose
+        Folding branch that sets M/V (:func:`foldcore.kinematics.degree4_mode_a`,
+        :func:`~foldcore.kinematics.degree4_mode_b`): the crease whose
         assignment differs from the other three is in the opposite-sign pair
         ((2, 4) in mode A, (1, 3) in mode B). Pehrson mode A is V, V, V, M.
         A crease that stays flat in a degenerate mode is assigned ``F``.

@@ -5,9 +5,9 @@ All coordinates are 2D (mm). Faces are returned counter-clockwise (seen from +z)
 The functions are vectorised (NumPy and SciPy; crossings from a cell grid or
 a shapely STRtree), so a 10⁶-vertex pattern is checked in seconds. Where a
 floating-point sign is too close to call (a near-degenerate face, nearly
-collinear or touching edges) they ask the same per-item code as before
-(``signed_area``, GEOS), so the results are those of the one-by-one versions
-kept in ``tests/naive.py``.
+collinear or touching edges) they ask per-item code (``signed_area``, GEOS),
+so the results are those of the one-by-one reference versions in
+``tests/naive.py``; ``bench/reading.py`` measures their speed.
 """
 from __future__ import annotations
 
@@ -370,8 +370,7 @@ def _crowded_vertices(vertices: np.ndarray, edges: np.ndarray) -> np.ndarray | N
     Two edges that share a vertex overlap only if they leave it in exactly the same
     direction, so only pairs sharing a crowded vertex need the pair test (found in
     O(E log E); a grid with one such vertex checks its pairs there, not all of them:
-    a 10⁶-vertex grid with a twin vertex was refused in 20.3 s checking every shared
-    pair).
+    docs/design.md#crossing-test-at-crowded-vertices).
     """
     n_edges = len(edges)
     origin = np.concatenate([edges[:, 0], edges[:, 1]])

@@ -2,9 +2,9 @@
 
 numba compiles a ``cache=True`` kernel on its first call and writes it next
 to its source; every later process loads it. Without this step a user's
-first ``foldcore simulate`` pays the compilation (a cold first fold took
-23–25 s on the 2-core Xeon today, bench/startup). The README's set-up
-(``make``) runs this module once, so the first simulation starts warm.
+first ``foldcore simulate`` pays the compilation (tens of seconds:
+docs/design.md#warm-up-at-set-up). The README's set-up (``make``) runs this
+module once, so the first simulation starts warm.
 
 What it folds — tiny scenes, each through the command line's defaults where
 possible, so exactly the kernels the default path uses are compiled:

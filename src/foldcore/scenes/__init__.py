@@ -1,5 +1,5 @@
-"""The paper's scenes (../SCENES.md): each builds its pattern, folds it, and measures
-the quantities the paper reports, beside the closed forms where they exist.
+"""The paper's scenes: each builds its pattern, folds it, and measures the quantities
+the paper reports, beside the closed forms of :mod:`foldcore.kinematics` where they exist.
 
 >>> from foldcore import scenes
 >>> run = scenes.run("d4v", quick=True)          # doctest: +SKIP

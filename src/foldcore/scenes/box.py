@@ -4,10 +4,9 @@ Provenance. The paper folds "the five-crease multiple-vertex origami used by
 Chen et al. [4] to make boxes (Fig. 2 of their paper)": six vertices, five
 hinges at each; folded, "the two panels adjacent to the mountain-fold hinge
 are put together and protrude in the inside volume". Chen, Peng & You's
-pattern (Science 2015, Fig. 2) is **not available here** (a search of the
-stored pages, docs and code found only the paper's abstract), so this
-scene uses a **reconstruction** from that description, not the source
-pattern: a hexagonal tray (:func:`hexagonal_tray`) —
+pattern (Science 2015, Fig. 2) is **not available here**, so this scene
+uses a **reconstruction** from that description, not the source pattern: a
+hexagonal tray (:func:`hexagonal_tray`) —
 
 * bottom: a regular hexagon of side ``SIDE`` = 50 mm;
 * six rectangular walls ``SIDE`` × ``HEIGHT`` (25 mm) hinged on its edges;
@@ -31,31 +30,22 @@ Thickening: every crease gets Eq. 7's width for a 180° fold, W = πH/2
 sub-strips (§6.1's 3–4), the default axis hinge; the crease pattern is the same
 at both thicknesses, the thick 2D sheets are not (panels inset by W/2, larger
 residual holes at the vertices). Every crease is actuated to its thin-sheet
-angle. Solver: ``rigid`` by default — it converges in 38–51 iterations
-(< 1.3 s) at both H and keeps the 180° mountain at its bound, whereas
-(measured with the arc hinge, the default then) ``lbfgs``/``anderson``/
-``paper`` at H = 4 mm converged to a state whose fin had folded ≈ 4° through
-itself (diagonal +176°, i.e. −184°), and ``paper`` did not converge at
-H = 1 mm in 40 000 iterations.
+angle. Solver: ``rigid`` by default, which converges at both H and keeps the
+180° mountain at its bound where the local/global strategies let the fin
+fold through itself (docs/design.md#scene-box-results).
 
 What comes out (measured, not imposed): the thick tray cannot close its
 corners exactly. With W = πH/2 the axis hinge pivots about its inner edges
 past θ* = 2·atan(π/2) = 115° (:mod:`foldcore.hinges`), so the 120° side
 creases and the 180° diagonal turn about lines off their crease lines, and
-each corner binds; the least-squares compromise tilts the walls outward
-(≈ 6.7° at 1 mm, ≈ 11.2° at 4 mm) and the box is a slightly flared tray,
-more so when thicker. The tilt does not vanish as H → 0 with W = πH/2
-(measured 6.1° at H = 0.1 mm): the pivot offsets and the hinges' compliance
+each corner binds; the least-squares compromise tilts the walls outward and
+the box is a slightly flared tray, more so when thicker. The tilt does not
+vanish as H → 0 with W = πH/2: the pivot offsets and the hinges' compliance
 both scale with H, so only the panels' finite size makes it grow with H.
 Real thick boxes avoid this with offsets (Chen et al.'s varied panel
-thickness), not SJT. Consequence for the volumes (measured): the 4 mm box
-keeps a smaller share of the thin tray's capacity at the same tilt (≈ 0.81
-against ≈ 0.95), and a smaller absolute capacity (≈ 158 against ≈ 172 cm³):
-the paper's "the volume of the box is also reduced". With the paper's arc
-hinge (``hinge="arc"``, measured before the axis hinge was the default) the
-walls flared 8.7° and 16.2°, the shares were 0.97 and 0.88, and the 4 mm
-box held slightly more (182 against 180 cm³), so the absolute claim was not
-reproduced then.
+thickness), not SJT. The 4 mm box keeps a smaller share of the thin tray's
+capacity at the same tilt and a smaller absolute capacity: the paper's "the
+volume of the box is also reduced".
 
 Quantities per thickness (``runs``): iterations, convergence, wall time;
 per crease family (bottom, side, diagonal) the target, the achieved mean

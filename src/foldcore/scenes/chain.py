@@ -12,15 +12,13 @@ spherical mechanisms in a row, each sharing panels with its two neighbours
 only — a linear chain without loops, and with the paper's element counts
 (16 panels; 22 creases × 2 sub-strips = 44 hinge elements). Facets a = 29 mm
 (across the chain), b = 22 mm (along it), γ = 60°, for a chain of about the
-paper's size (deployed, measured along its principal axes: 137.8 × 59.6 ×
-21.2 mm, against the paper's 13 × 4.5 cm; the lengths reported below are
-panel-centroid distances, hence shorter); hinge width W = πH/2 = 4.71 mm, the
-Eq. 7 minimum for a 180° fold.
+paper's size; hinge width W = πH/2 = 4.71 mm, the Eq. 7 minimum for a 180°
+fold.
 
 Not the paper's pattern in one respect, said plainly: in a Miura strip the
 zig-zag and straight creases cannot both sit at 60°. Deploying to facet tilt
 θ = 50° puts the straight creases at 61.6° and the zig-zag ones at 100°
-(kinematics.md's rigid-fold angles, every crease actuated).
+(:func:`foldcore.kinematics.miura_angles`, every crease actuated).
 
 Actuation: (1) deploy with every crease actuated to those angles; (2) make
 every crease passive, hold the first row's left panel (all its vertices,
@@ -28,42 +26,28 @@ every crease passive, hold the first row's left panel (all its vertices,
 corner vertices, α = 1e-2, a soft push) toward the held panel by 0, 5, …,
 60 mm along the transverse direction of the deployed state; each step starts
 from the last. The thick chain is not an exact zero-strain mechanism in the
-strained-joint model (hinge axes sit O(W) off the crease lines, issue 4), so
-the corner does not reach every commanded push: the achieved lengths are
-what is reported. The zig-zag hinges stop at flat (the rigid-body model's
-M/V side rows hold their panels within 0.01° of 180°), and with them the
-shortening along the chain. Measured (rigid strategy, 5 mm steps,
-2026-12-03): the deployed chain 23.5 × 122.0 mm (panel-centroid lengths);
-the zig-zag creases reach 180° at the 50 mm push (8.66 × 77.8 mm); the
-pushes after it shorten the chain along by 0.35 and 0.24 mm (3–5.6 mm per
-push before) but across by 0.67 and 0.61 mm (1.3–1.7 before): 7.38 ×
-77.2 mm at 60 mm, the straight creases opening 150.7 → 146.0°. Every push
-converges in 9–306 iterations. Before stop 34 the M/V rows read a valley a
-hair past flat as a crease 180° on its wrong side, a jump in the energy
-that froze the chain exactly at 180.000° from the 50 mm push on (8.7 ×
-79.3 mm); without any M/V rows the zig-zag panels fold on to 206°. That jump also stopped compatible flat folds short
-(:func:`foldcore.rigid_body.mv_side`), so the motion across after the stop
-is the model's, not the jump's.
+strained-joint model (hinge axes sit O(W) off the crease lines), so the
+corner does not reach every commanded push: the achieved lengths are what is
+reported. The zig-zag hinges stop at flat (the rigid-body model's M/V side
+rows hold their panels at 180°), and with them the shortening along the
+chain; pushes after that still shorten it a little across
+(docs/design.md#scene-chain-results).
 
 Hinge model: the paper's constant-length arc (``HINGE``), not foldcore's
 default axis hinge (:mod:`foldcore.hinges`), because this scene reproduces
-the paper's strained-joint experiment and because, measured on the axis
-hinge (rigid strategy, 5 mm steps): the deployment is exact (11
-iterations; 22.3 × 115.2 mm, every crease at its rigid-fold angle), but the
-push carries the zig-zag creases past θ* = 2·atan(W/H) = 115°, where the
-axis hinge pivots about its inner edges and every vertex binds; each 5 mm
-step then took 300–3 000 Levenberg–Marquardt iterations (3 of 12 steps
-unconverged at a 3 000 budget, 135 s for the scene) before the chain stopped
-at 8.5 × 71.9 mm from the 50 mm push on — a large-residual problem for the
-strategies, not a property of the chain (the time-to-solution issue).
+the paper's strained-joint experiment, and because the push carries the
+zig-zag creases past the axis hinge's pivot angle θ* = 2·atan(W/H) = 115°,
+where every vertex binds and each step becomes a slow large-residual problem
+for the strategies.
 
 Quantities: per push, the transverse length (distance between the two
 first-row panels' centroids), the longitudinal length (distance between the
 midpoints of the first and last rows' panel centroids), the largest zig-zag
 and straight fold magnitudes, the corner's distance from its commanded
 position, iterations and convergence; ``before``/``after`` lengths and the
-zero-thickness rigid-fold lengths at the deployed tilt (kinematics.miura_cell:
-transverse L, longitudinal (m − 1)·S; the thick hinges add ≈ W per crease).
+zero-thickness rigid-fold lengths at the deployed tilt
+(:func:`foldcore.kinematics.miura_cell`: transverse L, longitudinal
+(m − 1)·S; the thick hinges add ≈ W per crease).
 """
 from __future__ import annotations
 

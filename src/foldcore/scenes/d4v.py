@@ -7,22 +7,21 @@ replaced by straight chords, which changes no crease). M/V of mode A
 (V, V, V, M). Crease 1 is actuated to 90° (intermediate state) and then to
 180° (flat); the other creases are passive. k = 4 sub-strips per hinge.
 
-What comes out (measured, default axis hinge): the intermediate state is
-the closed form (90, 45, 90, −45)° in 9 iterations — every crease is below
-its pivot angle 2·atan(W/H) = 157/103/136/103° there, so the thick vertex
-folds as a rigid-origami one. Folded toward flat, all four creases pass
-their pivot angles, the panels turn about their touching inner edges, and
-the vertex binds: it stops at 161.7/135.2/161.2/−135.4° (stack height
-55.7 mm, 17.6 H), the report listing the pivoting creases, the strips'
-misfit and the panels' overlap. (With the paper's arc hinge it stopped at
-82.96° of 90° and at 134.4° of 180°.) Folding a thick vertex fully flat
-needs offsets or material strain that rigid panels and these hinges do not
-provide.
+What comes out, with the default axis hinge: the intermediate state is the
+closed form (90, 45, 90, −45)°, because every crease is below its pivot angle
+2·atan(W/H) = 157/103/136/103° there and the thick vertex folds as a
+rigid-origami one. Toward flat all four creases pass their pivot angles, the
+panels turn about their touching inner edges and the vertex binds short of
+flat; the report lists the pivoting creases, the strips' misfit and the
+panels' overlap (docs/design.md#scene-d4v-results). Folding a thick vertex
+fully flat needs offsets or material strain that rigid panels and these
+hinges do not provide.
 
 Quantities: the four fold angles at both states beside the zero-thickness
-closed form of mode A (kinematics.md) at the target and at the achieved ρ1,
-and the stack height at the flat state (extent of the folded solid along the
-normal of the panel left of crease 1; n stacked layers of H give ≥ n·H).
+closed form of mode A (:func:`foldcore.kinematics.degree4_mode_a`) at the
+target and at the achieved ρ1, and the stack height at the flat state (extent
+of the folded solid along the normal of the panel left of crease 1; n stacked
+layers of H give ≥ n·H).
 """
 from __future__ import annotations
 

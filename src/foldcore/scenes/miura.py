@@ -1,4 +1,4 @@
-"""miura — a Miura-ori sheet on its rigid-folding path (paper §5, SCENES.md).
+"""miura — a Miura-ori sheet on its rigid-folding path (paper §5).
 
 Provenance: the standard Miura-ori (parallelogram facets a × b, acute angle
 γ; :func:`foldcore.patterns.miura`); the paper uses it at any size as its
@@ -6,19 +6,19 @@ Provenance: the standard Miura-ori (parallelogram facets a × b, acute angle
 H = 1 mm, hinge width W = 2 mm (k = 2).
 
 Actuation: every crease to its zero-thickness rigid-fold angle at facet
-tilt θ = 30° (kinematics.md: zig-zag |ρ| = 2θ, straight tan(|ρ|/2) =
-cos γ tan θ), signed by its M/V. With the default axis hinge
-(:mod:`foldcore.hinges`) these angles are exactly compatible at any
-thickness, so the sheet reaches them (measured: every crease within 5e-5°,
-the report's rounding; 8 iterations); with ``hinge="arc"`` (the
-paper's, whose hinge axes sit off the crease lines) they were missed by up
-to 1.54°. One crease driven alone folds the whole sheet too
-(``tests/test_accuracy.py``, ``bench/accuracy.py``).
+tilt θ = 30° (:func:`foldcore.kinematics.miura_angles`: zig-zag |ρ| = 2θ,
+straight tan(|ρ|/2) = cos γ tan θ), signed by its M/V. With the default axis
+hinge (:mod:`foldcore.hinges`) these angles are exactly compatible at any
+thickness, so the sheet reaches them; with ``hinge="arc"`` (the paper's,
+whose hinge axes sit off the crease lines) it misses them
+(docs/design.md#scene-miura-results). One crease driven alone folds the
+whole sheet too (``tests/test_accuracy.py``, ``bench/accuracy.py``).
 
 Quantities: per crease family (zig-zag, straight) the closed-form angle, the
 achieved mean, and the largest deviation; the folded sheet's extents along
 x and y (centroids of the corner facets, whose distance is (n − 1)·L along x
-and (m − 1)·S along y in the zero-thickness closed form, kinematics.miura_cell:
+and (m − 1)·S along y in the zero-thickness closed form,
+:func:`foldcore.kinematics.miura_cell`:
 L = a√(1 − sin²θ sin²γ), S = b cosθ tanγ/√(1 + cos²θ tan²γ)).
 """
 from __future__ import annotations

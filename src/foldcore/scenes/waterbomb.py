@@ -10,15 +10,15 @@ folded from the flat sheet by hinge actuation — position 1: the three
 mountain creases to −82° (the prototype's θm), valleys passive; position 2:
 the three valleys to 55° (the prototype's θv), mountains passive. The paper
 reaches position 2 from position 1 by position actuation (popping the centre
-through); pushing the centre to its mirror image with all creases passive
-keeps the M/V signs (rigid strategy) but ends near θm = −180°, θv = 58°
-(not converged in 400 iterations, measured), not at Table 1's −20°/55°, so
-the pop-through is not reproduced yet. The final result (FOLD/PNG) is position 2.
+through); that pop-through is not reproduced
+(docs/design.md#scene-waterbomb-results). The final result (FOLD/PNG) is
+position 2.
 
 Quantities: θm, θv (mean over each family) at both positions beside Table 1
 (prototype −82/32 and −20/55; paper's simulation −82/24 and −17/58) and the
-zero-thickness closed form of the symmetric base (kinematics.waterbomb_minor:
-the minor magnitude for the actuated major one).
+zero-thickness closed form of the symmetric base
+(:func:`foldcore.kinematics.waterbomb_minor`: the minor magnitude for the
+actuated major one).
 """
 from __future__ import annotations
 
