@@ -14,7 +14,7 @@ What is tested and why the tolerances:
   buys on panels 5 H long, checked by the paper's map still being > 1° away
   after the same budget. Anderson is held to it on the constant-length arc
   hinge only: on the default axis hinge its energy test refuses many of its
-  extrapolations (docs/design.md#accelerated-strategies-on-one-hinge).
+  extrapolations (docs/architecture.md#accelerated-strategies-on-one-hinge).
 """
 from __future__ import annotations
 

@@ -602,7 +602,7 @@ def test_polar_rotation_is_the_best_rotation(cond, inverted):
     times that; with σ₂ = σ₃ (cond = 1, inverted) every rotation about one
     axis is optimal and only the optimum is checked.
     """
-    from elements._rotation import polar_rotation
+    from elements.rotation import polar_rotation
 
     rng = np.random.default_rng(int(cond) + inverted)
     eps = np.finfo(float).eps
@@ -621,7 +621,7 @@ def test_jacobi_rotation_is_the_best_rotation(rank, inverted):
     quaternion from a Jacobi eigen-decomposition reaches the optimum for every
     rank, inverted or not, and is the Kabsch rotation where that is unique
     (sensitivity ‖A‖/(σ₂ ∓ σ₃) ≤ 4 here: allowed gap 40·ε)."""
-    from elements._rotation import jacobi_rotation
+    from elements.rotation import jacobi_rotation
 
     rng = np.random.default_rng(10 * rank + inverted)
     eps = np.finfo(float).eps
@@ -645,7 +645,7 @@ def test_fitted_rotation_matches_the_svd_kabsch_rotation(cond, inverted):
     is 20·cond·ε. ``upper``
     is any bound ≥ Horn's largest eigenvalue: drawn 1e-12…1 above it.
     """
-    from elements._rotation import fitted_rotation
+    from elements.rotation import fitted_rotation
 
     rng = np.random.default_rng(int(cond) + inverted)
     eps = np.finfo(float).eps
@@ -670,7 +670,7 @@ def test_fitted_rotation_of_degenerate_covariances_is_a_rotation(rank):
     """Coincident (rank 0), collinear (1) or coplanar-with-a-zero-singular-value (2)
     covariances have a non-unique best rotation: any proper rotation reaching
     the optimum tr(Rᵀ A) = σ₁ + σ₂ + σ₃ will do, and no NaN may come out."""
-    from elements._rotation import fitted_rotation
+    from elements.rotation import fitted_rotation
 
     rng = np.random.default_rng(rank)
     for _ in range(100):
@@ -711,7 +711,7 @@ def test_fit_rotated_is_scale_free_between_the_current_shape_and_its_target(scal
     """A current shape much smaller (or larger) than its target — a collapsed
     element, or one far from its rest size — still gets the Kabsch rotation:
     the root search must not start so far above λ that it stops before it."""
-    from elements._rotation import fit_rotated
+    from elements.rotation import fit_rotated
 
     rng = np.random.default_rng(int(-np.log10(scale)) + 20)
     for _ in range(200):

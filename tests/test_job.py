@@ -1,4 +1,4 @@
-"""``foldcore.simulate`` and what a run tells its user (issue 19, items 3, 4, 6): the
+"""``foldcore.simulate`` and what a run tells its user: its option groups, the
 summary line, the binding and nothing-driven warnings, the progress bar, and the
 last iterate written as a partial result on Ctrl-C."""
 from __future__ import annotations
@@ -14,6 +14,7 @@ from foldcore import cli, patterns
 from foldcore.errors import RunWarning
 from foldcore.io import write_fold
 from foldcore.job import Interrupted
+from foldcore.options import OptionError
 from foldcore.simulation import Simulation
 
 REAL = "tests/data/real/"
@@ -32,14 +33,35 @@ def test_simulate_is_the_command_line_as_a_call(hinge_file, tmp_path):
     options = ["--subdivisions", "4", "--tolerance", "1e-9", "--max-iterations", "20000"]
     assert cli.main(["simulate", str(hinge_file), "-o", str(tmp_path / "cli.fold"),
                      "-q", *options]) == 0
-    result = foldcore.simulate(hinge_file, subdivisions=4, tolerance=1e-9,
-                               max_iterations=20_000, output=tmp_path / "api.fold")
+    result = foldcore.simulate(hinge_file, thickening={"subdivisions": 4},
+                               solving={"tolerance": 1e-9, "max_iterations": 20_000},
+                               outputs={"fold": tmp_path / "api.fold"})
     assert result.converged and result.fold_angles_deg[0] == pytest.approx(90.0, abs=1e-4)
     a, b = (json.loads((tmp_path / n).read_text()) for n in ("cli.fold", "api.fold"))
     assert a["edges_foldAngle"] == b["edges_foldAngle"]
     assert a["file_frames"][0]["vertices_coords"] == b["file_frames"][0]["vertices_coords"]
     with pytest.raises(TypeError):
-        foldcore.job.fold(hinge_file, thickness_mm=1.0)
+        foldcore.job.fold(hinge_file, thickness=1.0)
+    with pytest.raises(OptionError, match="thickening: unknown option 'thickness_mm'"):
+        foldcore.job.fold(hinge_file, thickening={"thickness_mm": 1.0})
+
+
+def test_options_are_checked_before_any_work_in_library_words(hinge_file, tmp_path, capsys):
+    """A value outside its range fails when its group is made, naming ``group.field``;
+    the command line says the same of its flag."""
+    from foldcore.options import Solving, Thickening
+
+    with pytest.raises(OptionError, match=r"solving.max_iterations must be an integer ≥ 1"):
+        Solving(max_iterations=0)
+    with pytest.raises(OptionError, match=r"solving.fold_percent must be in \[-100, 100\]"):
+        foldcore.simulate(hinge_file, solving={"fold_percent": 150})
+    with pytest.raises(OptionError, match="thickening.subdivisions"):
+        Thickening(subdivisions=0)
+    out = tmp_path / "never.fold"
+    assert cli.main(["simulate", str(hinge_file), "--fold-percent", "150", "-o", str(out)]) == 2
+    (line,) = capsys.readouterr().err.splitlines()
+    assert line == "foldcore: error: --fold-percent must be in [-100, 100], got 150.0"
+    assert not out.exists()
 
 
 def test_the_summary_line_gives_verdict_iterations_time_and_miss(hinge_file, capsys):
@@ -65,8 +87,9 @@ def test_a_run_that_binds_converged_says_its_targets_were_missed():
     the drawn angles; converged with every driven crease far off, and said so."""
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        result = foldcore.simulate(REAL + "bird-base-3d.fold", thickness=0.5,
-                                   sheet_size=100, fold_percent=30, max_iterations=3000)
+        result = foldcore.simulate(REAL + "bird-base-3d.fold", reading={"size": 100},
+                                   thickening={"thickness": 0.5},
+                                   solving={"fold_percent": 30, "max_iterations": 3000})
     binding = [str(w.message) for w in caught if w.category is RunWarning]
     assert result.converged
     (message,) = binding
@@ -108,7 +131,8 @@ def test_ctrl_c_writes_the_last_iterate_marked_partial(hinge_file, tmp_path, cap
     assert 0.0 < rep["fold_angles_deg"][0] < 90.0  # part way
     with pytest.raises(Interrupted) as info:
         calls.clear()
-        foldcore.simulate(hinge_file, subdivisions=4, solver="paper")
+        foldcore.simulate(hinge_file, thickening={"subdivisions": 4},
+                          solving={"solver": "paper"})
     assert info.value.result.iterations == 29 and info.value.written == {}
     assert np.isfinite(info.value.result.positions).all()
 
@@ -131,10 +155,9 @@ def test_the_readme_snippet_renders(tmp_path, monkeypatch):
 
 
 def test_a_crease_past_flat_reads_back_and_keeps_its_side(tmp_path):
-    """Issue 19: a mountain folded 0.54° past flat was written +179.46° and foldcore
-    refused its own output ('contradicts assignment M'). Now measured angles keep
-    their side (``on_assigned_side``): here the valley at 180.54° is kept in the
-    report, written within FOLD's range, and render/export read it back."""
+    """Measured angles keep their side (``on_assigned_side``): a valley at 180.54° is
+    kept in the report, written within FOLD's range, and render/export read it back
+    (a mountain written +179.46° would contradict its assignment)."""
     import dataclasses
 
     from folded import scene
@@ -157,7 +180,8 @@ def test_a_crease_past_flat_reads_back_and_keeps_its_side(tmp_path):
 def test_the_report_gives_the_effective_targets_at_the_fold_percent(hinge_file, tmp_path):
     """The crane at 30 % reported target_angles_deg 180 (the file's, not the run's)."""
     report = tmp_path / "r.json"
-    foldcore.simulate(hinge_file, subdivisions=4, fold_percent=30, report=report)
+    foldcore.simulate(hinge_file, thickening={"subdivisions": 4}, solving={"fold_percent": 30},
+                      outputs={"report": report})
     rep = json.loads(report.read_text())
     assert rep["target_angles_deg"][0] == pytest.approx(27.0)  # 30 % of 90°
     assert rep["actuation"]["creases"][0]["target_deg"] == pytest.approx(27.0)
@@ -171,9 +195,10 @@ def test_elastic_cells_cut_every_face_into_rings_and_fold_a_compatible_target(tm
     from foldcore.fabrication import read_result
 
     report = tmp_path / "diag.json"
-    done = foldcore.job.fold(REAL + "diagonal-cp.fold", thickness=0.5, sheet_size=100.0,
-                             fold_percent=90, elastic_cells=10.0, max_iterations=20_000,
-                             output=tmp_path / "diag.fold", report=report)
+    done = foldcore.job.fold(REAL + "diagonal-cp.fold", reading={"size": 100.0},
+                             thickening={"thickness": 0.5, "elastic_cells": 10.0},
+                             solving={"fold_percent": 90, "max_iterations": 20_000},
+                             outputs={"fold": tmp_path / "diag.fold", "report": report})
     faces = done.pattern.faces
     assert set(done.mesh.elastic) == set(range(len(faces)))
     assert all(kind == "rings" and n >= 2 for kind, n in done.mesh.elastic.values())

@@ -1,9 +1,9 @@
-"""numba keys a cached kernel on its own source file only; elements._cache drops the
+"""numba keys a cached kernel on its own source file only; elements.cache drops the
 package's cache files whenever any of its sources changed (a helper edited in
 _rotation.py must reach every kernel that calls it)."""
 from __future__ import annotations
 
-from elements import _cache
+from elements import cache as _cache
 
 
 def make_package(root):

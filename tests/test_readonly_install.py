@@ -2,7 +2,7 @@
 
 numba's ``cache=True`` raises ``no locator available`` at the decorator when
 neither ``NUMBA_CACHE_DIR``, the in-tree ``__pycache__`` nor ``~/.cache/numba``
-is writable. ``elements._cache.choose_cache_dir`` then falls back to another
+is writable. ``elements.cache.choose_cache_dir`` then falls back to another
 folder, or to no cache, with one warning line.
 
 The reproducer is real: a copy of the package sources with write permission
@@ -22,7 +22,7 @@ from pathlib import Path
 
 import pytest
 
-from elements import _cache
+from elements import cache as _cache
 
 SRC = Path(__file__).resolve().parents[1] / "src"
 IS_ROOT = hasattr(os, "geteuid") and os.geteuid() == 0
@@ -104,7 +104,7 @@ def test_with_no_writable_folder_at_all_kernels_run_uncached(install):
     site, tmp = install
     code = ("import tempfile; tempfile.tempdir = " + repr(str(site)) + "\n"
             "import foldcore.system, foldcore.strategies.rigid.normal\n"
-            "from elements._rotation import _det\n"
+            "from elements.rotation import _det\n"
             "print(_det(2.0, 0.0, 0.0, 0.0, 3.0, 0.0, 0.0, 0.0, 4.0))\n")
     proc = run_child(site, tmp, code)
     assert proc.returncode == 0, proc.stderr

@@ -50,14 +50,14 @@ def test_every_file_reads_or_is_refused_in_one_line_naming_it(name):
             assert (pattern.assignments != "B").any()
 
 
-def fold(name, percent, **options):
-    options = {"max_iterations": 3000, **options}
+def fold(name, percent, elastic_cells=None, max_iterations=3000, trust_assignment=False):
+    reading = foldcore.Reading(size=100.0, trust_assignment=trust_assignment)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        result = foldcore.simulate(REAL / name, thickness=0.5, sheet_size=100.0,
-                                   fold_percent=percent, **options)
-    reading = foldcore.Reading(size=100.0,
-                               trust_assignment=options.get("trust_assignment", False))
+        result = foldcore.simulate(
+            REAL / name, reading=reading,
+            thickening={"thickness": 0.5, "elastic_cells": elastic_cells},
+            solving={"fold_percent": percent, "max_iterations": max_iterations})
     pattern = foldcore.read(REAL / name, reading=reading)
     said = [str(w.message) for w in caught if w.category is RunWarning]
     return pattern, result, said

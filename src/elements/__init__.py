@@ -12,10 +12,10 @@ An element type is a small module holding
 
 Defining the subclass registers it. Third-party packages can also register
 types through the ``foldcore.elements`` entry-point group (loaded lazily, on the
-first lookup of an unknown name). See ``docs/elements.md``.
+first lookup of an unknown name). See ``docs/adding-an-element-type.md``.
 
 Importing the package first drops numba cache files compiled from other
-sources than the current ones (:mod:`elements._cache`: numba keys a kernel on
+sources than the current ones (:mod:`elements.cache`: numba keys a kernel on
 its own file only, not on the helpers it calls), after making sure numba has a writable cache
 folder (a read-only install without a writable home falls back to another
 folder, or to no cache, with one :class:`foldcore.errors.KernelCacheWarning`).
@@ -24,8 +24,8 @@ from pathlib import Path as _Path
 
 import numba as _numba
 
-from ._cache import choose_cache_dir as _choose_cache_dir
-from ._cache import drop_stale_kernels as _drop_stale_kernels
+from .cache import choose_cache_dir as _choose_cache_dir
+from .cache import drop_stale_kernels as _drop_stale_kernels
 
 _choose_cache_dir(_Path(__file__))  # before any cache=True decorator (read-only installs)
 _drop_stale_kernels(_Path(__file__).parent, _numba.__version__)

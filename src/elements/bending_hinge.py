@@ -41,7 +41,7 @@ import math
 from numba import njit, prange
 
 from ._registry import ElementType
-from ._rotation import fit_rotated
+from .rotation import fit_rotated
 from ._strip import distance, strip_widths
 
 HINGE_PARAMS = ("width", "height", "target", "sign", "max_angle", "floor", "model", "strips",
@@ -277,7 +277,7 @@ def prepare(indptr, rest, params, shapes):
     Local frame, centred, as :func:`batch` makes it: an actuated strip's
     target depends on its parameters only, so the engine computes it here
     once per change of targets instead of every iteration
-    (docs/design.md#prepared-shapes-of-actuated-strips). Passive strips' rows
+    (docs/architecture.md#prepared-shapes-of-actuated-strips). Passive strips' rows
     are not written.
     """
     for e in prange(len(indptr) - 1):

@@ -12,7 +12,7 @@ The projection rotates the rest shape onto the current one (Kabsch, det = +1).
 from numba import njit, prange
 
 from ._registry import ElementType
-from ._rotation import fit_rotated
+from .rotation import fit_rotated
 
 
 @njit(cache=True)

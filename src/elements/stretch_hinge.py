@@ -18,7 +18,7 @@ import math
 from numba import njit, prange
 
 from ._registry import ElementType
-from ._rotation import fit_rotated
+from .rotation import fit_rotated
 from ._strip import strip_widths
 
 STRETCH_PARAMS = ("width", "height", "ratio", "poisson")

@@ -10,8 +10,10 @@ Data flow: pattern → thick mesh → system → simulation → result → outpu
     result.fold_angles_deg[0]          # ≈ 90 (degrees, valley > 0)
 
     # or from a file, as the command line does (foldcore.job):
-    result = foldcore.simulate("crane.fold", thickness=0.5, sheet_size=200,
-                               fold_percent=30, output="crane-30.fold")
+    result = foldcore.simulate("crane.fold", reading={"size": 200},
+                               thickening={"thickness": 0.5},
+                               solving={"fold_percent": 30},
+                               outputs={"fold": "crane-30.fold"})
 
 Units: mm and degrees at every public API. Submodules are imported lazily so
 that ``import foldcore`` is fast and never imports numba kernels or pyvista.

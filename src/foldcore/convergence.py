@@ -8,7 +8,7 @@ step (:class:`Report`), and it decides whether the run ends ``converged``,
 rigid-body strategy's stopping rule, ``newton``'s) says whether its state
 is settled; a strategy without one (the local/global maps) is judged by the
 equilibrium probe of the paper's model (:class:`foldcore.probe.EquilibriumProbe`).
-A small step alone is never a verdict: `docs/design.md#a-small-step-is-not-a-verdict`.
+A small step alone is never a verdict: `docs/architecture.md#a-small-step-is-not-a-verdict`.
 """
 from __future__ import annotations
 

@@ -5,7 +5,7 @@ prism bent by φ (θ = kφ for the crease). Where the panels go is decided by
 the bent shape of the strip's end faces — a modelling choice, and one that
 decides whether thick vertices can fold at all. Three models
 (``thicken(..., hinge=...)``, ``--hinge``, FOLD ``foldcore:edges_hinge``);
-measured figures for each: docs/design.md#hinge-models-in-numbers.
+measured figures for each: docs/architecture.md#hinge-models-in-numbers.
 
 ``"axis"`` (default) — the panels turn about the crease's mid-line.
     The strip is an arc whose neutral axis has the length W·f(θ),

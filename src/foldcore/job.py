@@ -1,7 +1,8 @@
 """One fold from a file to its outputs — what ``foldcore simulate`` does, as a call.
 
->>> result = foldcore.simulate("crane.fold", thickness=0.5, sheet_size=200,
-...                            fold_percent=30, output="crane-30.fold")  # doctest: +SKIP
+>>> result = foldcore.simulate("crane.fold", reading={"size": 200},
+...                            thickening={"thickness": 0.5}, solving={"fold_percent": 30},
+...                            outputs={"fold": "crane-30.fold"})  # doctest: +SKIP
 
 Reads the pattern (:mod:`foldcore.io`, Origami Simulator's conventions:
 :mod:`foldcore.io.conventions`), checks every output path before any work
@@ -9,8 +10,9 @@ Reads the pattern (:mod:`foldcore.io`, Origami Simulator's conventions:
 percent (or along an animation's sweep) and writes the outputs all or nothing
 (:mod:`foldcore.outputs`). Warnings the run calls for — nothing driven, or
 converged with its targets missed — are :class:`foldcore.errors.RunWarning`.
-Every option is the command line's, with the same defaults and units (mm,
-degrees); the command line adds only its messages and exit codes.
+Every option is in one of four groups (:mod:`foldcore.options`), with the
+command line's defaults and units (mm, degrees); the command line maps its
+flags to them and adds only its messages and exit codes.
 """
 from __future__ import annotations
 

@@ -2,7 +2,7 @@
 
 Each window sits at least 10× inside the values at which a hinge scene was seen to
 fold wrongly, stop, raise from SVD or CHOLMOD, or go non-finite
-(docs/design.md#accepted-ranges-of-inputs); ``tests/test_limits.py`` folds the
+(docs/architecture.md#accepted-ranges-of-inputs); ``tests/test_limits.py`` folds the
 corners of the window. Coordinates relative to the sheet need no limit of
 their own.
 """

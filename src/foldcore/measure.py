@@ -25,7 +25,7 @@ def element_rotations(group, positions: np.ndarray) -> np.ndarray:
 
     All elements at once (segment sums over the slots), because a Python loop over
     the panels was a tenth of a fold path's time
-    (docs/design.md#panel-rotations-in-one-pass)."""
+    (docs/architecture.md#panel-rotations-in-one-pass)."""
     starts = group.indptr[:-1]
     sizes = np.diff(group.indptr)
     p = positions[group.indices]

@@ -370,7 +370,7 @@ def _crowded_vertices(vertices: np.ndarray, edges: np.ndarray) -> np.ndarray | N
     Two edges that share a vertex overlap only if they leave it in exactly the same
     direction, so only pairs sharing a crowded vertex need the pair test (found in
     O(E log E); a grid with one such vertex checks its pairs there, not all of them:
-    docs/design.md#crossing-test-at-crowded-vertices).
+    docs/architecture.md#crossing-test-at-crowded-vertices).
     """
     n_edges = len(edges)
     origin = np.concatenate([edges[:, 0], edges[:, 1]])

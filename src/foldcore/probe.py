@@ -4,7 +4,7 @@ The paper's map, L-BFGS and Anderson move a long panel only through its thin
 hinge faces, so far from the fold their steps can be far below tolerance ×
 size while the panels still turn: a small step is not a verdict. The probe
 runs when a step is within the limit, in three parts
-(`docs/design.md#the-equilibrium-probe`):
+(`docs/architecture.md#the-equilibrium-probe`):
 
 1. *Probe*: ``PROBE_STEPS`` plain steps of the map on scratch copies (the
    model's state is untouched); near a fixed point the map is linear, so once

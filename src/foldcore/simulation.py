@@ -335,7 +335,7 @@ class Simulation:
         is M or V, some crease is driven away from flat, the sheet is still flat
         (every crease within the floor of 0°) and not yet on its branch (some
         passive M/V crease less than ``BRANCH_LEFT_DEG`` on its side): a sweep's
-        later frames need no stage. Why: `docs/design.md#branch-selection`."""
+        later frames need no stage. Why: `docs/architecture.md#branch-selection`."""
         hinges = self.model.hinges
         if self.branch_floor_deg <= 0 or hinges is None:
             return False

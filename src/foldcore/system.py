@@ -16,7 +16,7 @@ import numpy as np
 import scipy.sparse as sp
 from numba import njit, prange
 
-from elements._cache import choose_cache_dir
+from elements.cache import choose_cache_dir
 
 from .linsolve import Factor, resolved_backend
 

@@ -155,7 +155,7 @@ class ThreadChooser:
 
 
 #: Element-vertex slots below which a simulation's kernels run on one thread (a
-#: parallel launch costs more than it saves there): `docs/design.md#threads`.
+#: parallel launch costs more than it saves there): `docs/architecture.md#threads`.
 SERIAL_BELOW_SLOTS = 500
 #: Vector length (3 × vertices) from which a serial simulation's steps hold BLAS to
 #: one thread too (OpenBLAS threads dot products of such vectors).

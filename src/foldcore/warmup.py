@@ -3,7 +3,7 @@
 numba compiles a ``cache=True`` kernel on its first call and writes it next
 to its source; every later process loads it. Without this step a user's
 first ``foldcore simulate`` pays the compilation (tens of seconds:
-docs/design.md#warm-up-at-set-up). The README's set-up (``make``) runs this
+docs/architecture.md#warm-up-at-set-up). The README's set-up (``make``) runs this
 module once, so the first simulation starts warm.
 
 What it folds — tiny scenes, each through the command line's defaults where

@@ -19,7 +19,7 @@ class HingeControls:
     over its k sub-strips; a NaN target makes a strip passive. Passive strips
     bent past their max angle become stops (their weight × ``stop_stiffness``)
     and the actuation sets the actuated strips' weights
-    (:mod:`foldcore.actuation`). Why stops: `docs/design.md#stops`.
+    (:mod:`foldcore.actuation`). Why stops: `docs/architecture.md#stops`.
 
     Parameters
     ----------

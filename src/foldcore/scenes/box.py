@@ -32,7 +32,7 @@ at both thicknesses, the thick 2D sheets are not (panels inset by W/2, larger
 residual holes at the vertices). Every crease is actuated to its thin-sheet
 angle. Solver: ``rigid`` by default, which converges at both H and keeps the
 180° mountain at its bound where the local/global strategies let the fin
-fold through itself (docs/design.md#scene-box-results).
+fold through itself (docs/architecture.md#scene-box-results).
 
 What comes out (measured, not imposed): the thick tray cannot close its
 corners exactly. With W = πH/2 the axis hinge pivots about its inner edges

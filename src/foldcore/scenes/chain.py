@@ -31,7 +31,7 @@ corner does not reach every commanded push: the achieved lengths are what is
 reported. The zig-zag hinges stop at flat (the rigid-body model's M/V side
 rows hold their panels at 180°), and with them the shortening along the
 chain; pushes after that still shorten it a little across
-(docs/design.md#scene-chain-results).
+(docs/architecture.md#scene-chain-results).
 
 Hinge model: the paper's constant-length arc (``HINGE``), not foldcore's
 default axis hinge (:mod:`foldcore.hinges`), because this scene reproduces

@@ -13,7 +13,7 @@ closed form (90, 45, 90, −45)°, because every crease is below its pivot angle
 rigid-origami one. Toward flat all four creases pass their pivot angles, the
 panels turn about their touching inner edges and the vertex binds short of
 flat; the report lists the pivoting creases, the strips' misfit and the
-panels' overlap (docs/design.md#scene-d4v-results). Folding a thick vertex
+panels' overlap (docs/architecture.md#scene-d4v-results). Folding a thick vertex
 fully flat needs offsets or material strain that rigid panels and these
 hinges do not provide.
 

@@ -11,7 +11,7 @@ straight tan(|ρ|/2) = cos γ tan θ), signed by its M/V. With the default axis
 hinge (:mod:`foldcore.hinges`) these angles are exactly compatible at any
 thickness, so the sheet reaches them; with ``hinge="arc"`` (the paper's,
 whose hinge axes sit off the crease lines) it misses them
-(docs/design.md#scene-miura-results). One crease driven alone folds the
+(docs/architecture.md#scene-miura-results). One crease driven alone folds the
 whole sheet too (``tests/test_accuracy.py``, ``bench/accuracy.py``).
 
 Quantities: per crease family (zig-zag, straight) the closed-form angle, the

@@ -11,7 +11,7 @@ mountain creases to −82° (the prototype's θm), valleys passive; position 2:
 the three valleys to 55° (the prototype's θv), mountains passive. The paper
 reaches position 2 from position 1 by position actuation (popping the centre
 through); that pop-through is not reproduced
-(docs/design.md#scene-waterbomb-results). The final result (FOLD/PNG) is
+(docs/architecture.md#scene-waterbomb-results). The final result (FOLD/PNG) is
 position 2.
 
 Quantities: θm, θv (mean over each family) at both positions beside Table 1

@@ -24,7 +24,7 @@ from __future__ import annotations
 
 from .base import SOLVERS, NoOptions, Strategy, available, get, unregister
 
-#: The default strategy: ``hybrid``. Why: `docs/design.md#the-default-strategy`.
+#: The default strategy: ``hybrid``. Why: `docs/architecture.md#the-default-strategy`.
 DEFAULT_SOLVER = "hybrid"
 
 __all__ = ["DEFAULT_SOLVER", "NoOptions", "SOLVERS", "Strategy", "available", "get",

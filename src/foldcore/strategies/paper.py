@@ -4,7 +4,7 @@ Every element is projected at x (the local step, in parallel), the weighted
 targets are gathered into b(x), and the prefactored K gives the new
 positions (the global step). Monotone in the energy, but it moves a long
 panel only through its thin hinge faces, so its iteration count grows with
-(panel length / thickness)²: `docs/design.md#why-more-than-the-papers-map`.
+(panel length / thickness)²: `docs/architecture.md#why-more-than-the-papers-map`.
 """
 from __future__ import annotations
 

@@ -3,7 +3,7 @@
 Each crease becomes a strip of its hinge width, split into sub-strips; the
 panels are the faces inset by half the width of each side; everything is
 extruded to thickness H, mid-plane at z = 0, and panels and strips share their
-points (docs/design.md#thickening-a-crease-pattern). Units: mm, angles in
+points (docs/architecture.md#thickening-a-crease-pattern). Units: mm, angles in
 degrees at this API.
 """
 from __future__ import annotations

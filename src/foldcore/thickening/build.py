@@ -24,7 +24,7 @@ def thicken(pattern: CreasePattern, thickness: float, hinge_width=None,
             stiffness=None, stretch=None, elastic=None,
             cell_size: float | None = None) -> ThickMesh:
     """Build the thick prism mesh of a crease pattern (paper §2.2;
-    docs/design.md#thickening-a-crease-pattern).
+    docs/architecture.md#thickening-a-crease-pattern).
 
     Parameters
     ----------
@@ -45,7 +45,7 @@ def thicken(pattern: CreasePattern, thickness: float, hinge_width=None,
     stiffness : dict, optional
         ``{"panel": (F,) or float, "hinge": (E,) or float}`` factors (> 0,
         default 1) multiplying the elements' volume weights
-        (docs/design.md#stiffness-factors).
+        (docs/architecture.md#stiffness-factors).
     stretch : dict {edge id: Poisson ratio ν}, optional
         Creases made stretch hinges (§6.3, group ``stretch_hinge``, one strip
         each, passive until :meth:`foldcore.Simulation.set_stretch_ratios`);
@@ -54,7 +54,7 @@ def thicken(pattern: CreasePattern, thickness: float, hinge_width=None,
         Elastic panels (§5.5), faces cut into cells: n cells for a bar (a
         quadrilateral with one crease side), an n1 × n2 grid for a plate, n
         rings for a facet; "plates" / "facets" for every face that can be one
-        (docs/design.md#elastic-panels-bars-plates-and-facets).
+        (docs/architecture.md#elastic-panels-bars-plates-and-facets).
     cell_size : float, optional
         Target cell length (mm) for ``"auto"`` counts.
 

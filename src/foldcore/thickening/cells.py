@@ -1,5 +1,5 @@
 """Elastic faces cut into cells: bars (strips beside one crease), plates (grids, in
-:mod:`.plates`) and facets (rings) (docs/design.md#elastic-panels-bars-plates-and-facets)."""
+:mod:`.plates`) and facets (rings) (docs/architecture.md#elastic-panels-bars-plates-and-facets)."""
 from __future__ import annotations
 
 import numpy as np

@@ -11,7 +11,7 @@ __all__ = ["PointTable", "area_centroid", "chord_params", "cross2d", "edge_of", 
 
 def vector_length(v) -> float:
     """Euclidean length of one vector (mm): ``np.linalg.norm``'s own arithmetic for a
-    1-D array, without its dispatch (docs/design.md#building-the-thick-mesh-fast)."""
+    1-D array, without its dispatch (docs/architecture.md#building-the-thick-mesh-fast)."""
     return math.sqrt(v.dot(v))
 
 

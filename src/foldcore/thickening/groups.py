@@ -88,7 +88,7 @@ def hinge_group(pattern, points, strip_points, widths, ks, thickness, hinges, st
     """The bending-hinge group: k × m sub-strips per crease (m segments along it), and
     each crease's strip ids ({crease: (k·m,) int64}). The footprints are gathered
     a crease at a time, the prisms and parameters built for all strips at once
-    (docs/design.md#building-the-thick-mesh-fast)."""
+    (docs/architecture.md#building-the-thick-mesh-fast)."""
     n_top = len(points)
     creases = list(strip_points)
     quads, series, lengths, strips_of, count = [], [], [], {}, 0
@@ -153,7 +153,7 @@ def _hinge_frame(pattern, e) -> np.ndarray:
     """(3, 3) columns: local x (across, toward the left face), y (up), z (along a→b).
 
     x = ẑ × u written out as ``np.cross`` evaluates it, signed zeros included
-    (docs/design.md#building-the-thick-mesh-fast).
+    (docs/architecture.md#building-the-thick-mesh-fast).
     """
     a, b = pattern.edges[e]
     d = pattern.vertices[b] - pattern.vertices[a]

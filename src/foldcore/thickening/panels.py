@@ -63,7 +63,7 @@ def _inset_fails(p, corners) -> np.ndarray:
 def panel_corners(pattern, widths, table):
     """Each face's inset corners ((m, 2) mm) and their point ids (added to ``table``
     face by face), the faces of one vertex count computed together
-    (docs/design.md#building-the-thick-mesh-fast). Raises on the first face (by id)
+    (docs/architecture.md#building-the-thick-mesh-fast). Raises on the first face (by id)
     whose inset fails."""
     offsets = _face_offsets(pattern, widths)
     corners = [None] * len(pattern.faces)

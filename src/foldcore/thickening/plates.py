@@ -1,5 +1,5 @@
 """Elastic plates: a quadrilateral face cut into a grid of quads that conforms with the
-strips along its sides (docs/design.md#elastic-panels-bars-plates-and-facets)."""
+strips along its sides (docs/architecture.md#elastic-panels-bars-plates-and-facets)."""
 from __future__ import annotations
 
 import numpy as np

@@ -23,7 +23,7 @@ def auto_subdivisions(width, thickness: float, max_angle_deg, hinge=DEFAULT_HING
     k = max(2, ceil(θmax / 45°)); for Eq. 8 hinges (``hinge="eq8"``, per
     hinge or for all) k is then raised, up to :data:`MAX_SUBDIVISIONS`, while
     θmax/k > 2·atan(W/(k·H)), the most one sub-strip can bend
-    (docs/design.md#sub-strips-per-hinge).
+    (docs/architecture.md#sub-strips-per-hinge).
 
     Parameters
     ----------

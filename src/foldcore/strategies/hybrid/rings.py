@@ -7,7 +7,7 @@ limit of stiff panels. :class:`RigidStart` steps the twin from the rest state
 through the run's stages; its state is then placed on the cells
 (:func:`place_cells`), where the finishing strategy goes on. Why: a linear
 step on free vertices turns a panel only by stretching it, so a fold through
-large angles costs ``newton`` many steps: `docs/design.md#elastic-cells`.
+large angles costs ``newton`` many steps: `docs/architecture.md#elastic-cells`.
 """
 from __future__ import annotations
 

@@ -13,7 +13,7 @@ cut into rings, which from the rest state starts on the mesh's rigid-panel
 twin (:mod:`.rings`); so does a run with a fading position target. Bare steps
 outside a run are steps of the finish. Changed targets start the next run
 with a rigid phase again; positions set from outside are continued from with
-L-BFGS. Why this composite: `docs/design.md#the-default-strategy`.
+L-BFGS. Why this composite: `docs/architecture.md#the-default-strategy`.
 """
 from __future__ import annotations
 

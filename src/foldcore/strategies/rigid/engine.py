@@ -4,7 +4,7 @@ Why: the paper's local/global map moves a long panel only through its thin
 hinge faces, so its iteration count grows with (panel length / thickness)².
 Here every rigid panel is a rigid body (rotation R_p, centroid c_p; its
 vertices follow exactly), so a panel's rotation is one unknown of the step
-whatever its length (`docs/design.md#the-rigid-body-strategy`).
+whatever its length (`docs/architecture.md#the-rigid-body-strategy`).
 
 :class:`RigidBodySolver` holds the configuration and composes collaborators
 with one job each: :class:`.layout.UnknownLayout` (the unknowns and their

@@ -44,11 +44,11 @@ import numpy as np
 from numba import njit, prange
 
 import elements
-from elements._cache import choose_cache_dir, drop_stale_kernels
-from elements._rotation import centroid, fit_about
+from elements.cache import choose_cache_dir, drop_stale_kernels
+from elements.rotation import centroid, fit_about
 
 choose_cache_dir(Path(__file__))  # before this module's cache=True kernels (read-only installs)
-# these kernels call elements._rotation: recompile them when it changes (elements._cache)
+# these kernels call elements.rotation: recompile them when it changes (elements.cache)
 drop_stale_kernels(Path(__file__).parent, numba.__version__, (Path(elements.__file__).parent,),
                    module=Path(__file__).stem)
 

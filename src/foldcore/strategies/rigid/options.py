@@ -10,7 +10,7 @@ import numpy as np
 class RigidOptions:
     """Tuning constants of the rigid-body strategy and its engine.
 
-    Why each value: `docs/design.md#the-rigid-body-strategy`.
+    Why each value: `docs/architecture.md#the-rigid-body-strategy`.
 
     Attributes
     ----------

@@ -29,7 +29,7 @@ def mv_side(t: np.ndarray, wall: float, slack: float) -> tuple[np.ndarray, np.nd
     0 on the assigned side (t ≥ −``slack``); t + ``slack`` where a crease crosses
     to the other side; beyond, back to 0 at t = −π with slope ``wall``: −π and
     +π are one dihedral, a crease folded flat, so a fold a hair past flat costs
-    only its overshoot. Why this shape: `docs/design.md#mv-side-rows`."""
+    only its overshoot. Why this shape: `docs/architecture.md#mv-side-rows`."""
     t = np.ascontiguousarray(t, dtype=float).ravel()
     value, slope = np.empty_like(t), np.empty_like(t)
     normal.mv_side_many(t, wall, slack, value, slope)

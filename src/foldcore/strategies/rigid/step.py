@@ -9,7 +9,7 @@ only if the energy decreases (or, at rounding level, if it came closer:
 :meth:`LevenbergMarquardt.closer_within_rounding`), tries the end of a
 geometric tail of aligned steps (:meth:`LevenbergMarquardt.extrapolated`),
 and updates λ by the gain ratio (Nielsen's rule). Why each part:
-`docs/design.md#the-rigid-body-strategy`. Units: mm, rad.
+`docs/architecture.md#the-rigid-body-strategy`. Units: mm, rad.
 """
 from __future__ import annotations
 

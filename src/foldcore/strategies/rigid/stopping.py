@@ -6,7 +6,7 @@ leaves a small distance (the step's length, or a bound from the steps'
 contraction, Deuflhard, "Newton Methods for Nonlinear Problems", 2004, §2.1)
 *and* lowers the energy by ≤ tolerance × E. Where the energy vanishes
 (compatible targets) its decrease is rounding noise, hence a floor. Why each
-part: `docs/design.md#the-rigid-body-stopping-rule`. Units: mm, mm⁵.
+part: `docs/architecture.md#the-rigid-body-stopping-rule`. Units: mm, mm⁵.
 """
 from __future__ import annotations
 

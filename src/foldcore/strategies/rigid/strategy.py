@@ -15,7 +15,7 @@ equilibrium to the mesh's own engine when it settles in the run's last stage
 there when the twin settled and the mesh's strips meet their bent shapes
 within the run's limit, else when the mesh's own steps settle. A run that
 continues a certified hand-over (a fold-percent sweep's next frame) steps the
-kept twin again. Why: `docs/design.md#the-coarse-twin`.
+kept twin again. Why: `docs/architecture.md#the-coarse-twin`.
 """
 from __future__ import annotations
 

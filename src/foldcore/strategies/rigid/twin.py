@@ -11,7 +11,7 @@ run from the rest state to the twin's equilibrium, and the mesh's own engine
 then starts there (:meth:`Twin.hand_over`: panels and crease angles copied,
 hinge-interior vertices placed on their strips' bent shapes). Where the
 sub-strips do change the equilibrium (binding, Eq. 8 trapezoids) the mesh's
-own steps finish. Why and what it saves: `docs/design.md#the-coarse-twin`.
+own steps finish. Why and what it saves: `docs/architecture.md#the-coarse-twin`.
 """
 from __future__ import annotations
 

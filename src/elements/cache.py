@@ -2,9 +2,9 @@
 
 numba's ``cache=True`` keys each compiled function on its *own* source file
 (modification time and size). A kernel that calls a helper from another
-module — every element type calls :func:`elements._rotation.fit_rotated` —
+module — every element type calls :func:`elements.rotation.fit_rotated` —
 keeps running the helper it was compiled with after the helper's file
-changes (docs/design.md#stale-kernels-after-a-helper-changes).
+changes (docs/architecture.md#stale-kernels-after-a-helper-changes).
 
 The guard: a stamp (SHA-256 of the package's ``*.py`` sources and the numba
 version) is kept beside numba's cache files; when it differs at import, every
@@ -22,7 +22,7 @@ after editing kernels). Editing any file of the package (even a docstring)
 recompiles every kernel once. A wheel install does not need it (reinstalling rewrites every
 source, which numba sees), an editable checkout does. Kernels outside this
 package (plugins) that call its helpers are not covered: clear their
-``__pycache__`` after upgrading foldcore (docs/elements.md).
+``__pycache__`` after upgrading foldcore (docs/adding-an-element-type.md).
 """
 from __future__ import annotations
 
@@ -77,12 +77,12 @@ def drop_stale_kernels(package_dir: Path, numba_version: str, extra_dirs=(),
         Part of the stamp (a new numba recompiles anyway; kept for clarity).
     extra_dirs : sequence of Path
         Folders of helpers the kernels call (a plugin passes the ``elements``
-        folder, so a foldcore upgrade that changes ``_rotation`` drops its
+        folder, so a foldcore upgrade that changes ``rotation`` drops its
         kernels too).
     module : str, optional
         Guard one module of ``package_dir`` only (its source, its cache files,
         its own stamp), e.g. a module of foldcore whose kernels call
-        ``elements._rotation``, so that editing the package's other files does
+        ``elements.rotation``, so that editing the package's other files does
         not recompile them.
 
     Returns

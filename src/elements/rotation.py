@@ -13,7 +13,7 @@ adjugate, then Newton steps on the rotation itself (one or two; at most
 conditioning of the problem, ε·λ/gap (:func:`quaternion_fit`,
 :func:`polish_quaternion`). It always gives a proper rotation (det = +1), also
 for inverted elements, in about half the time of the scaled Newton polar
-iteration (docs/design.md#rotation-fit-of-an-element).
+iteration (docs/architecture.md#rotation-fit-of-an-element).
 
 Where the eigen-gap is tiny (nearly collinear or coincident points:
 |κ| < ``GAP_MIN`` λ³, κ = Π(λⱼ − λ)) the Newton polar factor is used instead, and
