@@ -27,6 +27,7 @@ from hypothesis import HealthCheck, event, example, given, settings
 from hypothesis import strategies as st
 
 import foldcore.io as fio
+import foldcore.files as output_files
 from foldcore.errors import PatternError, PatternWarning
 from foldcore.io import fold as fold_module
 from foldcore.io import obj as obj_module
@@ -740,7 +741,7 @@ def test_writers_are_atomic(tmp_path, monkeypatch, writer, fail_at, existing):
         def __getattr__(self, name):
             return getattr(self.fh, name)
 
-    real = fold_module.atomic_write
+    real = output_files.atomic_write
 
     @contextmanager
     def wrapped(path):
@@ -751,8 +752,7 @@ def test_writers_are_atomic(tmp_path, monkeypatch, writer, fail_at, existing):
         def failing_fsync(fd):
             raise _Boom("fsync failed")
         monkeypatch.setattr(os, "fsync", failing_fsync)
-    monkeypatch.setattr(fold_module, "atomic_write", wrapped)
-    monkeypatch.setattr(obj_module, "atomic_write", wrapped)
+    monkeypatch.setattr(output_files, "atomic_write", wrapped)   # every writer's one way out
     with pytest.raises(KeyboardInterrupt if fail_at == "interrupt" else _Boom):
         _writers(BASES[2])[writer](target)
     assert sorted(os.listdir(tmp_path)) == ([target.name] if existing else [])
