@@ -52,45 +52,81 @@ def triangulate_polygon(xy, face: int | None = None) -> np.ndarray:
         The triangles do not cover exactly the polygon's area, or leave a vertex
         out (a polygon that is not simple, or degenerate).
     """
-    xy = np.asarray(xy, dtype=np.float64)
+    return triangulate_polygons([xy], None if face is None else [face])[0]
+
+
+def triangulate_polygons(polygons, faces=None) -> list:
+    """:func:`triangulate_polygon` of many polygons, checked all at once.
+
+    Parameters
+    ----------
+    polygons : sequence of (n_i, 2) float
+        mm.
+    faces : sequence of int, optional
+        The index named in the error of each polygon (default: its position).
+
+    Returns
+    -------
+    list of (n_i − 2, 3) int64, local indices in each polygon's orientation.
+    """
+    local = [np.asarray(xy, dtype=np.float64) for xy in polygons]
+    sizes = np.array([len(xy) for xy in local], dtype=np.int64)
+    faces = np.arange(len(local)) if faces is None else np.asarray(faces)
+    small = np.flatnonzero(sizes < 3)
+    if len(small):
+        raise TriangulationError(_not_simple(faces[small[0]], local[small[0]], (), 0.0))
+    # each polygon relative to its first vertex: small coordinates, exact areas
+    local = [np.ascontiguousarray(xy - xy[0]) for xy in local]
+    tris = [mapbox_earcut.triangulate_float64(xy, np.array([len(xy)], dtype=np.uint32))
+            .reshape(-1, 3).astype(np.int64) for xy in local]
+    flip, bad, covered = _covers(local, sizes, tris)
+    if bad.any():
+        i = int(np.argmax(bad))
+        raise TriangulationError(_not_simple(faces[i], local[i], tris[i], covered[i]))
+    return [t[:, ::-1] if f else t for t, f in zip(tris, flip)]
+
+
+def _covers(local: list, sizes: np.ndarray, tris: list):
+    """Per polygon: whether earcut's triangles need reversing into its orientation, whether
+    they fail to be n−2 of one winding covering its area (relative
+    :data:`AREA_TOLERANCE`), and the area they cover (mm²); (P,) bool, bool, float."""
+    starts = np.concatenate([[0], np.cumsum(sizes)[:-1]])
+    xy = np.vstack(local)
+    count = np.array([len(t) for t in tris], dtype=np.int64)
+    owner = np.repeat(np.arange(len(local)), count)
+    v = xy[np.vstack(tris) + np.repeat(starts, count)[:, None]]
+    ab, ac = v[:, 1] - v[:, 0], v[:, 2] - v[:, 0]
+    twice = ab[:, 0] * ac[:, 1] - ab[:, 1] * ac[:, 0]
+    following = np.arange(len(xy)) + 1
+    following[starts + sizes - 1] = starts               # each polygon closes on itself
+    polygon = np.repeat(np.arange(len(local)), sizes)
+    area2 = np.bincount(polygon, xy[:, 0] * xy[following, 1] - xy[following, 0] * xy[:, 1],
+                        minlength=len(local))
+    flip = np.bincount(owner, twice, minlength=len(local)) * area2 < 0
+    wound = twice * np.where(flip == (area2 >= 0), -1.0, 1.0)[owner]   # > 0 once flipped
+    wrong = np.bincount(owner, wound < 0, minlength=len(local)) > 0
+    covered = 0.5 * np.bincount(owner, np.abs(twice), minlength=len(local))
+    extent = (np.maximum.reduceat(xy, starts) - np.minimum.reduceat(xy, starts)).max(axis=1)
+    area = 0.5 * np.abs(area2)
+    tolerance = AREA_TOLERANCE * (area + sizes * extent ** 2 * 1e-6)
+    bad = (count != sizes - 2) | wrong | (np.abs(covered - area) > tolerance)
+    return flip, bad, covered
+
+
+def _not_simple(face, xy: np.ndarray, tris, covered: float) -> str:
+    """The message of a polygon (n, 2) mm whose triangles ``tris`` fail the checks."""
     n = len(xy)
-    local = xy - xy.min(axis=0) if n else xy        # small coordinates: exact areas
-    tris = mapbox_earcut.triangulate_float64(np.ascontiguousarray(local),
-                                             np.array([n], dtype=np.uint32))
-    tris = tris.reshape(-1, 3).astype(np.int64)
-    area = _shoelace(local)
-    twice = _twice_areas(local, tris)
-    if twice.sum() * area < 0:                      # into the polygon's orientation
-        tris, twice = tris[:, ::-1], -twice
-    _check_cover(local, tris, twice * (1.0 if area >= 0 else -1.0), abs(area), face)
-    return tris
+    area = abs(_shoelace(xy)) if n >= 3 else 0.0
+    left = np.setdiff1d(np.arange(n), np.asarray(tris, dtype=np.int64).ravel())
+    detail = f"; vertex {int(left[0])} left out" if len(left) else ""
+    return (f"cannot triangulate face {face}: its {n}-vertex polygon of {area:.6g} mm² is "
+            f"not simple ({len(tris)} triangle(s) covering {covered:.6g} mm²{detail})")
 
 
 def _shoelace(xy: np.ndarray) -> float:
     """Signed area of a polygon (n, 2), counter-clockwise > 0."""
-    return 0.5 * float(np.sum(xy[:, 0] * np.roll(xy[:, 1], -1) - np.roll(xy[:, 0], -1) * xy[:, 1]))
-
-
-def _twice_areas(xy: np.ndarray, tris: np.ndarray) -> np.ndarray:
-    """(T,) twice the signed area of each triangle."""
-    a, b, c = xy[tris[:, 0]], xy[tris[:, 1]], xy[tris[:, 2]]
-    return (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0])
-
-
-def _check_cover(xy, tris, twice, area: float, face) -> None:
-    """Refuse triangles that are not n−2 of the polygon's orientation (``twice``: twice
-    their areas, > 0 for that orientation) covering its ``area`` (mm²)."""
-    n = len(xy)
-    extent = float(np.ptp(xy, axis=0).max()) if n else 0.0
-    tolerance = AREA_TOLERANCE * (area + n * extent ** 2 * 1e-6)
-    covered = 0.5 * float(np.abs(twice).sum())
-    where = "a face" if face is None else f"face {face}"
-    if n < 3 or len(tris) != n - 2 or abs(covered - area) > tolerance or (twice < 0).any():
-        left = np.setdiff1d(np.arange(n), tris.ravel())
-        detail = f"; vertex {int(left[0])} left out" if len(left) else ""
-        raise TriangulationError(
-            f"cannot triangulate {where}: its {n}-vertex polygon of {area:.6g} mm² is not "
-            f"simple ({len(tris)} triangle(s) covering {covered:.6g} mm²{detail})")
+    x, y = xy[:, 0], xy[:, 1]
+    return 0.5 * float(x @ np.roll(y, -1) - np.roll(x, -1) @ y)
 
 
 def surface_triangles(mesh, surface: SurfaceFaces | None = None, return_faces: bool = False,
@@ -109,18 +145,17 @@ def surface_triangles(mesh, surface: SurfaceFaces | None = None, return_faces: b
     """
     surface = surface or surface_polygons(mesh)
     n_top = len(mesh.points)
+    caps = np.flatnonzero(surface.is_cap)
+    try:
+        local = triangulate_polygons([mesh.points[surface.loops[f] % n_top] for f in caps], caps)
+    except TriangulationError as exc:
+        raise TriangulationError(f"{source}: {exc}" if source else str(exc)) from None
+    cap_tris = dict(zip(caps.tolist(), local))
     tris, owner = [], []
-    for f, (loop, cap) in enumerate(zip(surface.loops, surface.is_cap)):
-        if cap:
-            try:
-                local = triangulate_polygon(mesh.points[loop % n_top], face=f)
-            except TriangulationError as exc:
-                raise TriangulationError(f"{source}: {exc}" if source else str(exc)) from None
-            # a bottom loop is reversed, so its footprint is clockwise: the
-            # triangles keep that orientation, outward (−z) at rest
-            tris.append(loop[local])
-        else:
-            tris.append(loop[[[0, 1, 2], [0, 2, 3]]])
+    for f, loop in enumerate(surface.loops):
+        # a bottom loop is reversed, so its footprint is clockwise: the triangles keep
+        # that orientation, outward (−z) at rest; a side quad is split in two
+        tris.append(loop[cap_tris[f]] if f in cap_tris else loop[[[0, 1, 2], [0, 2, 3]]])
         owner.append(np.full(len(tris[-1]), f, dtype=np.int64))
     out = np.vstack(tris) if tris else np.zeros((0, 3), dtype=np.int64)
     if return_faces:
