@@ -1,8 +1,8 @@
-"""Property-based fuzzing of the crease-pattern readers (issue 7, input hardening).
+"""Property-based fuzzing of the crease-pattern readers.
 
 Property: every reader either returns a valid :class:`CreasePattern` or raises
 :class:`PatternError` whose message is non-empty and names the source given.
-Any other exception, or the ``_build`` safety net firing, is a bug.
+Any other exception, or the ``build_pattern`` safety net firing, is a bug.
 
 Example counts: a few hundred per test by default (the whole file stays fast
 for CI); ``FOLDCORE_FUZZ=long`` runs 10 000 per test::
@@ -91,7 +91,7 @@ def outcome(call, *names):
 
     Fails the test on any exception but PatternError, on a refusal message
     that is empty, does not name one of ``names`` or is not printable UTF-8,
-    and on the ``_build`` safety net (an unexpected exception inside).
+    and on the ``build_pattern`` safety net (an unexpected exception inside).
     Warnings other than PatternWarning (numpy overflow...) are errors.
     """
     with warnings.catch_warnings():
@@ -667,8 +667,8 @@ def test_fold_regressions(name):
 
 
 def test_fold_dict_python_sequences():
-    """Before: tuples refused ("must be 2 or 3 finite numbers, got (0, 0)"), an empty
-    NumPy faces array raised ValueError. Now read as the equivalent JSON file is."""
+    """A Python caller's tuples and an empty NumPy faces array read as the equivalent
+    JSON file does."""
     d = BASE_FOLDS[0]
     expected = parse_fold(json.dumps(d).encode(), "r.fold").pattern
     for change in ({"vertices_coords": [tuple(v) for v in d["vertices_coords"]],

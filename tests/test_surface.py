@@ -2,8 +2,7 @@
 
 A non-convex panel (a U, its notch 10 mm wide and 20 mm deep) is triangulated
 by earcut: the triangles cover exactly the polygon's area (mm²) and none lies
-outside it, where a fan from the first vertex (the old mesh export's) spans
-the notch. The STL of a mesh with that panel is closed, outward and encloses
+outside it, where a fan from the first vertex spans the notch. The STL of a mesh with that panel is closed, outward and encloses
 the prisms' volume; ``ThickMesh.export`` writes the same bytes.
 """
 from __future__ import annotations

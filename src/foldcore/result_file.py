@@ -130,8 +130,8 @@ MAX_REACH = 1e3  # × (sheet extent + thickness): farthest a folded vertex may l
 def _check_reach(positions, pattern, thickness: float, source: str) -> None:
     """Refuse a folded frame with a vertex farther than ``MAX_REACH`` × (the sheet's
     extent + thickness) from the frame's median: no fold of the sheet puts one
-    there, and such values overflow the rotation fits (a coordinate of 1e308
-    made ``np.linalg.svd`` run without end)."""
+    there, and such values overflow the rotation fits (``np.linalg.svd`` does not
+    return on a coordinate of 1e308)."""
     extent = float(np.ptp(pattern.vertices, axis=0).max()) + float(thickness)
     reach = np.abs(positions - np.median(positions, axis=0)).max(axis=1)
     far = np.flatnonzero(~(reach <= MAX_REACH * extent))
