@@ -244,13 +244,13 @@ def _polydata(x, surf, tris, face, chosen):
     return poly
 
 
-def _surface_parts(mesh, positions):
+def _surface_parts(mesh, positions, source: str | None = None):
     """(panels, hinges, edge lines) of the outer surface at ``positions`` (N, 3) mm: the
     panel and hinge triangles as :func:`surface_polydata` (None when there are none)
-    and every polygon edge as a line."""
+    and every polygon edge as a line; ``source``: the file named in errors."""
     pv = require_pyvista()
     surf = surface_polygons(mesh)
-    tris, face = surface_triangles(mesh, surf, return_faces=True)
+    tris, face = surface_triangles(mesh, surf, return_faces=True, source=source)
     x = np.asarray(positions, dtype=float)
     panels, hinges = (_polydata(x, surf, tris, face,
                                 np.flatnonzero(surf.is_hinge[face] == is_hinge))
@@ -340,7 +340,8 @@ class Renderer:
         self._box = [0.0, 1.0, 0.0, 1.0]
         self._title = None
         try:
-            self.panels, self.hinges, self.lines = _surface_parts(mesh, mesh.rest_positions)
+            self.panels, self.hinges, self.lines = _surface_parts(
+                mesh, mesh.rest_positions, getattr(pattern, "source", None))
             self._add_panels()
             self._add_edges()
             if scalars is None:

@@ -70,6 +70,8 @@ def triangulate_polygons(polygons, faces=None) -> list:
     list of (n_i − 2, 3) int64, local indices in each polygon's orientation.
     """
     local = [np.asarray(xy, dtype=np.float64) for xy in polygons]
+    if not local:
+        return []
     sizes = np.array([len(xy) for xy in local], dtype=np.int64)
     faces = np.arange(len(local)) if faces is None else np.asarray(faces)
     small = np.flatnonzero(sizes < 3)
@@ -109,7 +111,7 @@ def _covers(local: list, sizes: np.ndarray, tris: list):
     extent = (np.maximum.reduceat(xy, starts) - np.minimum.reduceat(xy, starts)).max(axis=1)
     area = 0.5 * np.abs(area2)
     tolerance = AREA_TOLERANCE * (area + sizes * extent ** 2 * 1e-6)
-    bad = (count != sizes - 2) | wrong | (np.abs(covered - area) > tolerance)
+    bad = (count != sizes - 2) | wrong | ~(np.abs(covered - area) <= tolerance)  # NaN: bad
     return flip, bad, covered
 
 
