@@ -130,10 +130,10 @@ MUTANTS = [
            "(v > MAX_COORDINATE_MM)", "huge negative coordinates accepted", "readers"),
     Mutant("hinge-width-zero", F + "io/obj.py", "if width is None or width <= 0:",
            "if width is None or width < 0:", "hinge file accepts width 0", "readers"),
-    Mutant("reach-nan", F + "fabrication.py", "far = np.flatnonzero(~(reach <= MAX_REACH * extent))",
+    Mutant("reach-nan", F + "result_file.py", "far = np.flatnonzero(~(reach <= MAX_REACH * extent))",
            "far = np.flatnonzero(reach > MAX_REACH * extent)",
            "result reader accepts a NaN folded vertex", "results"),
-    Mutant("no-thickness", F + "fabrication.py", "    if fold.thickness is None:\n",
+    Mutant("no-thickness", F + "result_file.py", "    if fold.thickness is None:\n",
            "    if False:\n", "result reader accepts a file without foldcore:thickness",
            "results"),
 ]

@@ -1,8 +1,8 @@
-"""Property-based fuzzing of the crease-pattern readers (issue 7, input hardening).
+"""Property-based fuzzing of the crease-pattern readers.
 
 Property: every reader either returns a valid :class:`CreasePattern` or raises
 :class:`PatternError` whose message is non-empty and names the source given.
-Any other exception, or the ``_build`` safety net firing, is a bug.
+Any other exception, or the ``build_pattern`` safety net firing, is a bug.
 
 Example counts: a few hundred per test by default (the whole file stays fast
 for CI); ``FOLDCORE_FUZZ=long`` runs 10 000 per test::
@@ -27,6 +27,7 @@ from hypothesis import HealthCheck, event, example, given, settings
 from hypothesis import strategies as st
 
 import foldcore.io as fio
+import foldcore.files as output_files
 from foldcore.errors import PatternError, PatternWarning
 from foldcore.io import fold as fold_module
 from foldcore.io import obj as obj_module
@@ -90,7 +91,7 @@ def outcome(call, *names):
 
     Fails the test on any exception but PatternError, on a refusal message
     that is empty, does not name one of ``names`` or is not printable UTF-8,
-    and on the ``_build`` safety net (an unexpected exception inside).
+    and on the ``build_pattern`` safety net (an unexpected exception inside).
     Warnings other than PatternWarning (numpy overflow...) are errors.
     """
     with warnings.catch_warnings():
@@ -666,8 +667,8 @@ def test_fold_regressions(name):
 
 
 def test_fold_dict_python_sequences():
-    """Before: tuples refused ("must be 2 or 3 finite numbers, got (0, 0)"), an empty
-    NumPy faces array raised ValueError. Now read as the equivalent JSON file is."""
+    """A Python caller's tuples and an empty NumPy faces array read as the equivalent
+    JSON file does."""
     d = BASE_FOLDS[0]
     expected = parse_fold(json.dumps(d).encode(), "r.fold").pattern
     for change in ({"vertices_coords": [tuple(v) for v in d["vertices_coords"]],
@@ -740,7 +741,7 @@ def test_writers_are_atomic(tmp_path, monkeypatch, writer, fail_at, existing):
         def __getattr__(self, name):
             return getattr(self.fh, name)
 
-    real = fold_module.atomic_write
+    real = output_files.atomic_write
 
     @contextmanager
     def wrapped(path):
@@ -751,8 +752,7 @@ def test_writers_are_atomic(tmp_path, monkeypatch, writer, fail_at, existing):
         def failing_fsync(fd):
             raise _Boom("fsync failed")
         monkeypatch.setattr(os, "fsync", failing_fsync)
-    monkeypatch.setattr(fold_module, "atomic_write", wrapped)
-    monkeypatch.setattr(obj_module, "atomic_write", wrapped)
+    monkeypatch.setattr(output_files, "atomic_write", wrapped)   # every writer's one way out
     with pytest.raises(KeyboardInterrupt if fail_at == "interrupt" else _Boom):
         _writers(BASES[2])[writer](target)
     assert sorted(os.listdir(tmp_path)) == ([target.name] if existing else [])

@@ -1,11 +1,11 @@
-"""Property-based fuzzing of the result-file reader (issue 18, item 2).
+"""Property-based fuzzing of the result-file reader.
 
 Real result files written by ``foldcore simulate -o`` (the hinge scene and a
 degree-4 vertex) and one with an elastic panel (``write_result``) are
 corrupted: keys deleted, types swapped, numbers replaced by NaN/inf/huge/
 negative, lists emptied, nested or truncated, frames duplicated or dropped.
 
-Property: :func:`foldcore.fabrication.read_result` returns a valid
+Property: :func:`foldcore.result_file.read_result` returns a valid
 :class:`ResultFile` (whose STL and, if its footprint fits, SVG can be made or
 are refused with an ExportError) or raises a :class:`FoldcoreError` whose
 one-line message names the file. Any other exception is a bug, and so is a

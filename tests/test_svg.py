@@ -1,4 +1,4 @@
-"""SVG crease patterns in Origami Simulator's colours (issue 19, item 2)."""
+"""SVG crease patterns in Origami Simulator's colours."""
 from __future__ import annotations
 
 import warnings
@@ -115,11 +115,11 @@ def test_not_an_svg_is_one_line(tmp_path):
 
 
 def test_a_t_join_next_to_a_crossing_is_not_an_overlap(tmp_path):
-    """Origami Simulator's traditionalCrane.svg: a valley starting 2.4 px from a
-    mountain it crosses was snapped onto it, and the short piece left near the
-    crossing was near both lines — refused as 'overlap with different crease types'
-    (the reproducer: the file itself). A piece is typed by the segment it lies along
-    (direction within PARALLEL); the small case checks a snapped T-join's pieces."""
+    """Origami Simulator's traditionalCrane.svg has a valley starting 2.4 px from a
+    mountain it crosses: it is snapped onto it, and the short piece left near the
+    crossing lies near both lines, yet is no overlap of different crease types. A
+    piece is typed by the segment it lies along (direction within PARALLEL); the
+    small case checks a snapped T-join's pieces."""
     body = ('<rect x="0" y="0" width="400" height="400" fill="none" stroke="#000"/>'
             '<line x1="0" y1="0" x2="400" y2="400" stroke="#f00"/>'
             '<line x1="202.4" y1="200" x2="400" y2="150" stroke="#00f"/>')  # 1.7 px off

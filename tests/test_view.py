@@ -1,4 +1,4 @@
-"""``simulate --series`` and ``foldcore view`` (issue 19, item 7): the fold-percent
+"""``simulate --series`` and ``foldcore view``: the fold-percent
 sweep as one FOLD file, and a self-contained page that shows it, loaded in headless
 Chromium (Debian's, installed by ``make test``) and checked on its screenshots."""
 from __future__ import annotations

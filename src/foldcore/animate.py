@@ -22,6 +22,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from . import files
+from .files import ExportError
 from .render import RenderError
 
 FORMATS = (".gif", ".mp4")
@@ -69,10 +71,8 @@ def check_output(path) -> str:
     """
     import os
 
-    from .fabrication import _check_folder
-
     suffix = os.path.splitext(os.fspath(path))[1].lower()
-    _check_folder(os.fspath(path))
+    files.check_folder(path, ExportError)
     if suffix not in FORMATS:
         raise RenderError(f"{os.fspath(path)}: animation must be .gif or .mp4, "
                           f"got {suffix or 'no suffix'!r}")
@@ -83,9 +83,9 @@ def check_output(path) -> str:
     except ImportError:
         raise RenderError("animations need imageio and Pillow: pip install "
                           "'foldcore[render]'") from None
-    from .render import _pyvista
+    from .render import require_pyvista
 
-    _pyvista()  # the frames are rendered with it: fail now, not after the sweep
+    require_pyvista()  # the frames are rendered with it: fail now, not after the sweep
     if suffix == ".mp4":
         try:
             import imageio_ffmpeg  # noqa: F401
@@ -204,15 +204,13 @@ def write_animation(path, frames, fps: float = 10.0) -> None:
     consecutive frames). MP4: H.264 via imageio-ffmpeg, yuv420p; frames are
     padded with white to even sizes (the codec's requirement).
     """
-    from .fabrication import atomic_path
-
     suffix = check_output(path)
     if not (np.isfinite(fps) and 0 < fps <= 100):
         raise RenderError(f"fps must be in (0, 100], got {fps!r}")
     if not len(frames):
         raise RenderError("no frames to write")
     stack = np.stack([np.asarray(f, dtype=np.uint8)[..., :3] for f in frames])
-    with atomic_path(path, suffix=suffix) as tmp:
+    with files.atomic_path(path, suffix=suffix) as tmp:
         if suffix == ".gif":
             import imageio.v3 as iio
 

@@ -1,25 +1,17 @@
 """Where a command's outputs go: checked before any work, written all or nothing.
 
-The output contract (issue 18): a destination that cannot be written is found
-before the run — not after a long fold, with a temporary file's name in the
-message — and a run writes either every output it was asked for or none
-(each file goes to a temporary name in its own folder and is renamed over
-the destination only when every writer has succeeded;
-:func:`foldcore.io.fold.atomic_path`). A signal that ends the process (the
-CLI turns SIGINT and SIGTERM into exceptions) removes the temporary files on
-its way out; SIGKILL cannot be caught and may leave a ``.NAME.PID.HEX.tmp``.
+A destination that cannot be written is found before the run, not after a
+long fold, and the message names the option and the path as the user gave
+them. The files themselves are written by :mod:`foldcore.files`: each to a
+temporary name in its own folder, renamed over the destination only when
+every writer has succeeded (:func:`all_or_nothing`), the temporary files
+removed on any error or signal.
 """
 from __future__ import annotations
 
 import os
-from contextlib import ExitStack, contextmanager
 
-from .errors import FoldcoreError
-
-
-class OutputError(FoldcoreError, ValueError):
-    """An output path cannot be written: no such folder, a folder, an input file, or
-    given twice."""
+from .files import OutputError, all_or_nothing  # noqa: F401  (part of this API)
 
 
 def check_destinations(outputs: dict, inputs=(), suffixes: dict | None = None) -> None:
@@ -64,25 +56,3 @@ def check_destinations(outputs: dict, inputs=(), suffixes: dict | None = None) -
         if target in seen:
             raise OutputError(f"{where}: also given to {seen[target]}")
         seen[target] = option
-
-
-@contextmanager
-def all_or_nothing(paths: dict):
-    """Temporary paths for every destination, renamed over them only if the block
-    succeeds; on any exception (a signal's included) every temporary is removed
-    and no destination is touched.
-
-    Parameters
-    ----------
-    paths : dict {key: path or None}
-
-    Yields
-    ------
-    dict {key: temporary path}, for the keys whose path is not None (each ends
-    with its destination's suffix, for writers that choose a format by name).
-    """
-    from .io.fold import atomic_path
-
-    with ExitStack() as stack:
-        yield {key: stack.enter_context(atomic_path(path, os.path.splitext(os.fspath(path))[1]))
-               for key, path in paths.items() if path}

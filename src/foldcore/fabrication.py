@@ -14,46 +14,36 @@ does not contradict the other: cut outline black (its boundary), mountain red,
 valley blue, facet yellow, other hinges magenta (its undriven), panels grey
 (SVG stroke colours; DXF ACI 7, 1, 5, 2, 6, 8). Stroke width and margin are mm
 options; by default a thousandth of the sheet's larger extent (at most
-``SVG_STROKE_MAX_MM``, a laser cutter's hairline) and 2 % of it, so a
-unit-square sheet is not drawn with strokes 5 % of its width.
+``SVG_STROKE_MAX_MM``, a laser cutter's hairline) and 2 % of it.
 
 Panel and hinge outlines share their common sides (the score lines); which
 layer is cut, scored or only drawn is the laser operator's choice. Every
 outline is one closed polyline, collinear points removed. SVG is written by
-hand (three element types, exact mm units through ``viewBox``, deterministic
-output, no dependency); DXF through ezdxf (the ``export`` extra), the
-reference DXF writer for Python, ``$INSUNITS`` = mm.
+hand (exact mm units through ``viewBox``, deterministic output); DXF through
+ezdxf (the ``export`` extra), ``$INSUNITS`` = mm.
 
-Folded solid (3D printing, CAD): binary STL of the outer surface of the prism
-mesh at given positions, written with NumPy (a 50-byte record per triangle is
-all the format is; meshio would add a dependency and write to a path we
-could not make atomic). Caps (top/bottom faces) are ear-clipped on the flat
-footprint, where every panel is a simple polygon, so non-convex panels are
-triangulated correctly; side faces are quads split in two. Each triangle is
-wound counter-clockwise seen from outside: the surface is closed, every edge
-is shared by exactly two triangles, and its signed volume is the solid's.
-
-Every file is written atomically (:func:`atomic_path`): it appears complete
-or not at all.
-
-Result files: :func:`read_result` reads a FOLD written by ``foldcore simulate
--o`` (crease pattern + folded-form frame with the solid's 3D coordinates) and
-rebuilds the ThickMesh it came from (see its docstring for why).
+Folded solid (3D printing, CAD): binary STL (mm) of the outer surface,
+:func:`foldcore.surface.write_stl`. Result files (``foldcore simulate -o``)
+are read back by :func:`foldcore.result_file.read_result`. Every file is
+written atomically (:mod:`foldcore.files`): it appears complete or not at all.
+The public names of those modules are re-exported here. Design notes:
+``docs/design.md#fabrication-files``.
 """
 from __future__ import annotations
 
 import io
-import os
 from contextlib import contextmanager
-from dataclasses import dataclass
 
 import numpy as np
 
-from . import limits
-from .errors import FoldcoreError, PatternError
-from .io.fold import atomic_path as io_atomic_path
-from .io.fold import atomic_write
+from . import files
+from .files import ExportError  # noqa: F401  (part of this API)
 from .mesh import SurfaceFaces, surface_polygons  # noqa: F401  (part of this API)
+from .result_file import (FOOTPRINT_TOLERANCE, MAX_REACH,  # noqa: F401  (part of this API)
+                          ResultFile, read_result)
+from .surface import (TriangulationError, enclosed_volume,  # noqa: F401  (part of this API)
+                      stl_bytes, surface_edges, surface_triangles, triangulate_polygon,
+                      write_stl)
 
 LAYERS = {"CUT": {"dxf_colour": 7, "svg": "#000000"},      # black: the boundary
           "PANEL": {"dxf_colour": 8, "svg": "#808080"},    # grey
@@ -66,160 +56,29 @@ LAYERS = {"CUT": {"dxf_colour": 7, "svg": "#000000"},      # black: the boundary
 SVG_MARGIN_SHARE = 0.02
 SVG_STROKE_SHARE = 1e-3
 SVG_STROKE_MAX_MM = 0.1
-#: Largest RMS misfit (fraction of the thickness) of a panel's rebuilt footprint
-#: to its folded shape before :func:`read_result` refuses the flat outlines.
-FOOTPRINT_TOLERANCE = 0.05
-_STL_RECORD = np.dtype([("normal", "<f4", (3,)), ("vertices", "<f4", (3, 3)),
-                        ("attribute", "<u2")])
-
-
-class ExportError(FoldcoreError, ValueError):
-    """A fabrication file cannot be made (bad geometry, missing package, no output)."""
 
 
 # ------------------------------------------------------------------- writing
 @contextmanager
 def atomic_path(path, suffix: str | None = None):
-    """:func:`foldcore.io.fold.atomic_path` after checking the folder exists
+    """:func:`foldcore.files.atomic_path` after checking the folder exists
     (:class:`ExportError` naming it); the temporary name ends with ``suffix``
     (default: ``path``'s own suffix), so format-by-name writers still work."""
-    target = os.fspath(path)
-    _, name = _check_folder(target)
-    suffix = os.path.splitext(name)[1] if suffix is None else suffix
-    with io_atomic_path(target, suffix) as tmp:
+    files.check_folder(path, ExportError)
+    with files.atomic_path(path, suffix) as tmp:
         yield tmp
 
 
-def _check_folder(target: str) -> tuple[str, str]:
-    """(folder, name) of an output path; ExportError naming it if the folder is missing."""
-    folder, name = os.path.split(os.path.abspath(target))
-    if not name or not os.path.isdir(folder):
-        raise ExportError(f"{target}: cannot write there (no such folder: {folder})")
-    return folder, name
-
-
 def write_bytes(path, data: bytes) -> None:
-    """Write ``data`` to ``path`` atomically (temporary file, fsync, rename)."""
-    _check_folder(os.fspath(path))
-    with atomic_write(path, binary=True) as fh:
-        fh.write(data)
+    """Write ``data`` to ``path`` atomically, after checking its folder (ExportError)."""
+    files.check_folder(path, ExportError)
+    files.write_bytes(path, data)
 
 
-# ------------------------------------------------------------------- surface
-
-
-def triangulate_polygon(xy) -> np.ndarray:
-    """Ear-clipping triangulation of a simple polygon, (n−2, 3) local indices.
-
-    Parameters
-    ----------
-    xy : (n, 2) float
-        Vertices in order (either orientation; collinear points allowed).
-
-    Returns
-    -------
-    (n−2, 3) int64, each triangle in the polygon's own orientation.
-    """
-    xy = np.asarray(xy, dtype=float)
-    n = len(xy)
-    area2 = float(np.sum(xy[:, 0] * np.roll(xy[:, 1], -1) - np.roll(xy[:, 0], -1) * xy[:, 1]))
-    order = list(range(n)) if area2 >= 0 else list(range(n))[::-1]
-    eps = 1e-12 * max(float(np.ptp(xy, axis=0).max()), 1e-300) ** 2
-    tris = []
-    while len(order) > 3:
-        for t in range(len(order)):
-            a, b, c = order[t - 1], order[t], order[(t + 1) % len(order)]
-            if _cross2(xy[a], xy[b], xy[c]) > eps and not _any_inside(xy, order, a, b, c, eps):
-                tris.append((a, b, c))
-                del order[t]
-                break
-        else:
-            raise ExportError("cannot triangulate a face: its polygon is not simple")
-    tris.append(tuple(order))
-    out = np.array(tris, dtype=np.int64)
-    return out if area2 >= 0 else out[:, ::-1]
-
-
-def _cross2(a, b, c) -> float:
-    return float((b[0] - a[0]) * (c[1] - b[1]) - (b[1] - a[1]) * (c[0] - b[0]))
-
-
-def _any_inside(xy, order, a, b, c, eps) -> bool:
-    """Is any polygon vertex other than a, b, c inside or on triangle abc (CCW)?"""
-    others = [i for i in order if i not in (a, b, c)]
-    if not others:
-        return False
-    p = xy[others]
-    inside = np.ones(len(others), dtype=bool)
-    for u, v in ((a, b), (b, c), (c, a)):
-        e = xy[v] - xy[u]
-        inside &= e[0] * (p[:, 1] - xy[u][1]) - e[1] * (p[:, 0] - xy[u][0]) >= -eps
-    return bool(inside.any())
-
-
-def surface_triangles(mesh, surface: SurfaceFaces | None = None, return_faces: bool = False):
-    """(T, 3) int64 vertex ids of the outer surface, outward (counter-clockwise) winding.
-
-    Caps are triangulated on the flat footprint ``mesh.points`` (valid for any
-    simple panel); side quads are split along a diagonal. With
-    ``return_faces`` also the (T,) index of each triangle's face in ``surface``.
-    """
-    surface = surface or surface_polygons(mesh)
-    n_top = len(mesh.points)
-    tris, owner = [], []
-    for f, (loop, cap) in enumerate(zip(surface.loops, surface.is_cap)):
-        if cap:
-            local = triangulate_polygon(mesh.points[loop % n_top])
-            # a bottom loop is reversed, so its footprint is clockwise: the
-            # triangles keep that orientation, outward (−z) at rest
-            tris.append(loop[local])
-        else:
-            tris.append(loop[[[0, 1, 2], [0, 2, 3]]])
-        owner.append(np.full(len(tris[-1]), f, dtype=np.int64))
-    out = np.vstack(tris) if tris else np.zeros((0, 3), dtype=np.int64)
-    if return_faces:
-        return out, (np.concatenate(owner) if owner else np.zeros(0, dtype=np.int64))
-    return out
-
-
-def surface_edges(surface: SurfaceFaces) -> np.ndarray:
-    """(K, 2) int64 distinct polygon edges of the outer surface (vertex ids, sorted pairs)."""
-    pairs = [np.column_stack([loop, np.roll(loop, -1)]) for loop in surface.loops]
-    if not pairs:
-        return np.zeros((0, 2), dtype=np.int64)
-    return np.unique(np.sort(np.vstack(pairs), axis=1), axis=0)
-
-
-def enclosed_volume(positions, triangles) -> float:
-    """Signed volume (mm³) enclosed by a closed triangle surface (divergence theorem)."""
-    v = np.asarray(positions, dtype=float)[np.asarray(triangles)]
-    return float(np.einsum("ij,ij->i", v[:, 0], np.cross(v[:, 1], v[:, 2])).sum() / 6.0)
-
-
-# ------------------------------------------------------------------- STL
-def stl_bytes(mesh, positions=None, header: str = "foldcore thick solid, mm") -> bytes:
-    """Binary STL of the mesh's outer surface at ``positions`` (N, 3) mm (default: rest)."""
-    x = mesh.rest_positions if positions is None else np.asarray(positions, dtype=float)
-    if x.shape != (mesh.n_vertices, 3) or not np.isfinite(x).all():
-        raise ExportError(f"positions must be a finite ({mesh.n_vertices}, 3) array of mm, "
-                          f"got shape {x.shape}")
-    tris = surface_triangles(mesh)
-    v = x[tris]
-    normal = np.cross(v[:, 1] - v[:, 0], v[:, 2] - v[:, 0])
-    length = np.linalg.norm(normal, axis=1)
-    normal = np.divide(normal, length[:, None], out=np.zeros_like(normal),
-                       where=length[:, None] > 0)
-    records = np.zeros(len(tris), dtype=_STL_RECORD)
-    records["normal"], records["vertices"] = normal, v
-    head = header.encode("ascii", "replace")[:80].ljust(80, b" ")
-    if head.lower().startswith(b"solid"):   # binary STL must not look like ASCII STL
-        head = b"foldcore " + head[:71]
-    return head + np.uint32(len(tris)).tobytes() + records.tobytes()
-
-
-def write_stl(path, mesh, positions=None) -> None:
-    """Write :func:`stl_bytes` to ``path`` atomically."""
-    write_bytes(path, stl_bytes(mesh, positions))
+def _write_text(path, text: str) -> None:
+    """Write ``text`` to ``path`` atomically, after checking its folder (ExportError)."""
+    files.check_folder(path, ExportError)
+    files.write_text(path, text)
 
 
 # ------------------------------------------------------------------- outlines
@@ -385,239 +244,14 @@ def write_dxf(path, mesh, pattern=None) -> None:
     _write_text(path, dxf_text(sheet_outlines(mesh, pattern)))
 
 
-def _write_text(path, text: str) -> None:
-    _check_folder(os.fspath(path))
-    with atomic_write(path) as fh:
-        fh.write(text)
-
-
-# ------------------------------------------------------------------- results
-@dataclass(frozen=True)
-class ResultFile:
-    """A simulation result read back from FOLD.
-
-    Attributes
-    ----------
-    pattern : CreasePattern
-    mesh : ThickMesh
-        Rebuilt with :func:`foldcore.thicken`; its surface equals the file's.
-    positions : (N, 3) float
-        Folded vertex positions, mm.
-    thickness : float
-        mm.
-    footprint_misfit_mm : float
-        Largest RMS distance between a rigid panel's rebuilt flat shape,
-        best-fit rotated, and its folded shape (mm); small when the rebuilt
-        hinge widths are those simulated (elastic cells, which deform, are
-        left out).
-    source : str
-    """
-
-    pattern: object
-    mesh: object
-    positions: np.ndarray
-    thickness: float
-    footprint_misfit_mm: float
-    source: str
-
-    def check_footprint(self) -> None:
-        """Refuse flat outlines whose hinge widths differ from the simulated ones.
-
-        Raises
-        ------
-        PatternError
-            ``footprint_misfit_mm`` > ``FOOTPRINT_TOLERANCE`` × thickness.
-        """
-        limit = FOOTPRINT_TOLERANCE * self.thickness
-        if self.footprint_misfit_mm > limit:
-            raise PatternError(
-                f"{self.source}: the panels of the folded frame do not fit the flat sheet "
-                f"rebuilt with the file's hinge widths (misfit {self.footprint_misfit_mm:.3g} mm "
-                f"> {limit:.3g} mm); pass the --hinge-width used with simulate")
-
-
-def read_result(path, hinge_width=None, subdivisions=None) -> ResultFile:
-    """Read a FOLD result (``foldcore simulate -o``) and rebuild its thick mesh.
-
-    The file holds the crease pattern (with ``foldcore:thickness`` and the
-    hinge widths) and a ``foldedForm`` frame with the solid's 3D coordinates
-    and outer faces. The stored faces alone cannot tell panels from hinges
-    nor mountain from valley, so the ThickMesh is rebuilt with
-    :func:`foldcore.thicken` from the file's pattern and thickness; thicken is
-    deterministic, so the same settings give the same vertex ids, and the
-    rebuilt mesh is accepted only if its outer faces equal the stored ones.
-    The stored coordinates are then the positions of the rebuilt mesh: panels,
-    sub-strips and their creases (M/V) are all known.
-
-    Parameters
-    ----------
-    path : str or os.PathLike
-    hinge_width : float, optional
-        mm; as given to simulate (``--hinge-width``); default: the file's widths.
-    subdivisions : int or "auto", optional
-        As given to simulate; default: try ``auto`` (with the file's hinge
-        models, ``foldcore:edges_hinge``; without them the default model,
-        then Eq. 8), then 1 … 16 sub-strips on every crease.
-
-    Raises
-    ------
-    PatternError
-        Unreadable or malformed file, no folded frame, no thickness, or no
-        rebuilt mesh matching the stored faces.
-    """
-    from .io.fold import (_parse_json, edges_poisson, faces_cells, fold_file_from_dict,
-                          read_bytes)
-    from .measure import element_rotations
-
-    source = os.fspath(path)
-    d = _parse_json(read_bytes(source), source)
-    fold = fold_file_from_dict(d, source)
-    positions, faces = _folded_frame(d, source)
-    if fold.thickness is None:
-        raise PatternError(f"{source}: no foldcore:thickness; not a foldcore result file")
-    _check_reach(positions, fold.pattern, fold.thickness, source)
-    if hinge_width is not None:
-        limits.check_width(hinge_width, fold.pattern.vertices, "--hinge-width", source)
-    recipe = {"elastic": faces_cells(d, len(fold.pattern.faces), source) or None,
-              "stretch": edges_poisson(d, fold.pattern.n_edges, source) or None,
-              "hinge": fold.hinge}
-    mesh = _matching_mesh(fold.pattern, fold.thickness, hinge_width, subdivisions,
-                          positions, faces, source, recipe)
-    panels = mesh.groups[mesh.panel_group]
-    rot = element_rotations(panels, positions)
-    misfit = 0.0
-    for e in range(len(panels)):
-        if int(panels.source[e]) in mesh.elastic:
-            continue  # elastic cells deform by design: only rigid panels test the widths
-        s = panels.slots(e)
-        p = positions[panels.indices[s]]
-        diff = p - p.mean(axis=0) - panels.rest[s] @ rot[e].T
-        misfit = max(misfit, float(np.sqrt((diff ** 2).sum(axis=1).mean())))
-    return ResultFile(fold.pattern, mesh, positions, fold.thickness, misfit, source)
-
-
-MAX_REACH = 1e3  # × (sheet extent + thickness): farthest a folded vertex may lie from the rest
-
-
-def _check_reach(positions, pattern, thickness: float, source: str) -> None:
-    """Refuse a folded frame with a vertex farther than ``MAX_REACH`` × (the sheet's
-    extent + thickness) from the frame's median: no fold of the sheet puts one
-    there, and such values overflow the rotation fits (a coordinate of 1e308
-    made ``np.linalg.svd`` run without end, issue 18)."""
-    extent = float(np.ptp(pattern.vertices, axis=0).max()) + float(thickness)
-    reach = np.abs(positions - np.median(positions, axis=0)).max(axis=1)
-    far = np.flatnonzero(~(reach <= MAX_REACH * extent))
-    if len(far):
-        v = int(far[0])
-        raise PatternError(f"{source}: folded frame: vertex {v} at {positions[v].tolist()} lies "
-                           f"beyond {MAX_REACH:g} × the sheet's extent ({extent:g} mm) from "
-                           "the others; not a fold of this sheet")
-
-
-def _folded_frame(d: dict, source: str):
-    """(N, 3) positions (mm) and faces of the last ``foldedForm`` frame of a FOLD dict."""
-    from .io.fold import UNIT_MM
-
-    frames = d.get("file_frames")
-    frames = [f for f in frames if isinstance(f, dict)] if isinstance(frames, list) else []
-    for i, f in enumerate(frames):
-        if not isinstance(f.get("frame_classes", []), list):
-            raise PatternError(f"{source}: file_frames[{i}].frame_classes must be a list of "
-                               f"strings, got {f['frame_classes']!r}")
-    folded = [f for f in frames if "foldedForm" in (f.get("frame_classes") or [])]
-    if not folded:
-        raise PatternError(f"{source}: no folded frame (file_frames with frame_classes "
-                           "'foldedForm'); write one with foldcore simulate -o")
-    frame = folded[-1]
-    unit = frame.get("frame_unit", d.get("frame_unit", "unit"))
-    if not isinstance(unit, str) or unit not in UNIT_MM:
-        raise PatternError(f"{source}: folded frame: unknown frame_unit {unit!r}")
-    x = _frame_coords(frame.get("vertices_coords"), source) * UNIT_MM[unit]
-    if not np.isfinite(x).all():
-        v = int(np.flatnonzero(~np.isfinite(x).all(axis=1))[0])
-        raise PatternError(f"{source}: folded frame: vertex {v} overflows when converted "
-                           f"to mm (frame_unit {unit!r})")
-    return x, _frame_faces(frame.get("faces_vertices"), len(x), source)
-
-
-def _frame_coords(rows, source: str) -> np.ndarray:
-    """(N, 3) float of a folded frame's ``vertices_coords``: finite JSON numbers only."""
-    from .io.fold import ARRAY, _number, _short
-
-    if not isinstance(rows, ARRAY) or not rows:
-        raise PatternError(f"{source}: folded frame: vertices_coords must be a non-empty "
-                           f"list of [x, y, z], got {_short(rows)}")
-    out = []
-    for i, row in enumerate(rows):
-        xyz = [_number(c) for c in row] if isinstance(row, ARRAY) else []
-        if len(xyz) != 3 or None in xyz:
-            raise PatternError(f"{source}: folded frame: vertices_coords[{i}] must be 3 "
-                               f"finite numbers [x, y, z], got {_short(row)}")
-        out.append(xyz)
-    return np.array(out, dtype=float)
-
-
-def _frame_faces(rows, n: int, source: str) -> list:
-    """A folded frame's ``faces_vertices`` as tuples of vertex ids in 0..n-1."""
-    from .io.fold import ARRAY, _index, _short
-
-    if not isinstance(rows, ARRAY):
-        raise PatternError(f"{source}: folded frame: faces_vertices must be a list of "
-                           f"vertex-id lists, got {_short(rows)}")
-    faces = []
-    for i, row in enumerate(rows):
-        ids = [_index(v, n) for v in row] if isinstance(row, ARRAY) else [None]
-        if None in ids:
-            raise PatternError(f"{source}: folded frame: faces_vertices[{i}] must be vertex "
-                               f"ids in 0..{n - 1}, got {_short(row)}")
-        faces.append(tuple(ids))
-    return faces
-
-
-def _matching_mesh(pattern, thickness, hinge_width, subdivisions, positions, faces, source,
-                   recipe=None):
-    """The ThickMesh whose outer faces are ``faces`` (see :func:`read_result`);
-    ``recipe``: thicken's ``elastic``/``stretch``/``hinge`` as stored in the file."""
-    from .errors import MeshError
-    from .mesh import surface_faces
-    from .thickening import MAX_SUBDIVISIONS, thicken
-
-    recipe = dict(recipe or {})
-    hinge = recipe.pop("hinge", None)
-    if subdivisions is not None:
-        candidates = [(subdivisions, hinge)]
-    else:  # without stored models: the default, then Eq. 8 (whose auto counts differ)
-        candidates = [("auto", hinge)] + ([("auto", "eq8")] if hinge is None else []) + \
-                     [(k, hinge) for k in range(1, MAX_SUBDIVISIONS + 1)]
-    wanted = sorted(tuple(sorted(f)) for f in faces)
-    first_error = None
-    for k, model in candidates:
-        try:
-            mesh = thicken(pattern, thickness, hinge_width, k, hinge=model, **recipe)
-        except MeshError as exc:
-            first_error = first_error or exc
-            continue
-        if mesh.n_vertices != len(positions):
-            continue
-        if sorted(tuple(sorted(f.tolist())) for f in surface_faces(mesh)) == wanted:
-            return mesh
-    if first_error is not None and subdivisions is not None:
-        raise first_error
-    tried = "subdivisions " + (str(subdivisions) if subdivisions is not None
-                               else f"auto and 1..{MAX_SUBDIVISIONS}")
-    raise PatternError(f"{source}: the folded frame ({len(positions)} vertices, {len(faces)} "
-                       f"faces) matches no thick mesh rebuilt from the file (thickness "
-                       f"{thickness:g} mm, {tried}); pass the --subdivisions and "
-                       "--hinge-width used with simulate")
-
-
 # ------------------------------------------------------------------- all at once
 def export(result: ResultFile, svg=None, dxf=None, stl=None, stroke_mm: float | None = None,
            margin_mm: float | None = None) -> list:
     """Write the fabrication files asked for; returns the paths written.
 
-    Every file's contents are made first, then each is written atomically,
-    so an error (bad geometry, missing ezdxf) leaves no file behind.
+    Every file's contents are made first, then all are written or none
+    (:func:`foldcore.files.all_or_nothing`), so an error (bad geometry,
+    missing ezdxf, a full disk) leaves no file behind.
 
     Parameters
     ----------
@@ -633,7 +267,7 @@ def export(result: ResultFile, svg=None, dxf=None, stl=None, stroke_mm: float | 
         raise ExportError("nothing to export: give --svg, --dxf and/or --stl")
     for path in (svg, dxf, stl):
         if path:
-            _check_folder(os.fspath(path))  # every destination before any write
+            files.check_folder(path, ExportError)  # every destination before any write
     contents = []
     if svg or dxf:
         result.check_footprint()
@@ -644,10 +278,9 @@ def export(result: ResultFile, svg=None, dxf=None, stl=None, stroke_mm: float | 
         if dxf:
             contents.append((dxf, dxf_text(outlines)))
     if stl:
-        contents.append((stl, stl_bytes(result.mesh, result.positions)))
-    for path, data in contents:
-        if isinstance(data, bytes):
-            write_bytes(path, data)
-        else:
-            _write_text(path, data)
+        contents.append((stl, stl_bytes(result.mesh, result.positions, source=result.source)))
+    with files.all_or_nothing(dict(enumerate(p for p, _ in contents))) as tmp:
+        for i, (_, data) in enumerate(contents):
+            with open(tmp[i], "xb") as fh:
+                fh.write(data if isinstance(data, bytes) else data.encode("utf-8"))
     return [p for p, _ in contents]

@@ -56,28 +56,12 @@ class Fold:
 
 
 def load(path, *, hinges=None, reading=None) -> Loaded:
-    """Read a FOLD file, or an OBJ/STL mesh with its hinge file, checking the ranges
-    arithmetic survives (:mod:`foldcore.limits`)."""
-    import os
+    """Read a FOLD or SVG file, or an OBJ/STL mesh with its hinge file
+    (:func:`foldcore.io.read_file`, which chooses the reader by suffix)."""
+    from .io import read_file
 
-    from .errors import PatternError
-    from .io import Reading, read, read_fold_file
-
-    source = os.fspath(path)
-    reading = Reading() if reading is None else reading
-    if source.lower().endswith(".fold"):
-        if hinges:
-            raise PatternError(f"{source}: --hinges only goes with an OBJ/STL pattern")
-        fold = read_fold_file(source, reading)
-        return Loaded(fold.pattern, fold.thickness, fold.stiffness, fold.hinge)
-    if source.lower().endswith(".svg"):
-        if hinges:
-            raise PatternError(f"{source}: --hinges only goes with an OBJ/STL pattern")
-        return Loaded(read(source, reading=reading), None, None, None)
-    if reading.scale is not None or reading.size is not None:
-        raise PatternError(f"{source}: --scale and --sheet-size apply to FOLD and SVG "
-                           "patterns; an OBJ/STL mesh is read in mm")
-    return Loaded(read(source, hinges=hinges), None, None, None)
+    read = read_file(path, hinges=hinges, reading=reading)
+    return Loaded(read.pattern, read.thickness, read.stiffness, read.hinge)
 
 
 def simulate(path, *, hinges=None, reading=None, thickening=None, solving=None,

@@ -170,27 +170,32 @@ class ThickMesh:
         return faces, kinds
 
     def to_pyvista(self, positions: np.ndarray | None = None):
-        """A ``pyvista.PolyData`` of the prism surfaces (pyvista imported lazily)."""
-        import pyvista as pv
+        """The outer surface as a ``pyvista.PolyData`` of triangles at ``positions`` (N, 3)
+        mm (default: rest), with cell data ``is_hinge``, ``strip``, ``edge``, ``bending``
+        (:func:`foldcore.render.surface_polydata`; needs the ``render`` extra)."""
+        from .render import surface_polydata
 
-        faces, kinds = self.prism_faces()
-        pts = self.rest_positions if positions is None else np.asarray(positions)
-        flat = np.concatenate([np.r_[len(f), f] for f in faces])
-        mesh = pv.PolyData(pts, flat)
-        mesh.cell_data["is_hinge"] = np.array([k != self.panel_group for k in kinds])
-        return mesh
+        return surface_polydata(self, positions)
 
     def export(self, path, positions: np.ndarray | None = None) -> None:
-        """Write the prism surfaces to VTU/VTK/STL/OBJ/PLY (format from suffix).
+        """Write the outer surface at ``positions`` (N, 3) mm (default: rest) as binary
+        STL (mm), atomically (:func:`foldcore.surface.write_stl`).
 
-        Uses meshio (imported lazily). STL output is triangulated.
+        Raises
+        ------
+        ExportError
+            ``path`` does not end in ``.stl`` (other formats:
+            ``mesh.to_pyvista(positions).save(path)``), or as ``write_stl``.
         """
-        import meshio
+        import os
 
-        faces, _ = self.prism_faces()
-        pts = self.rest_positions if positions is None else np.asarray(positions)
-        tris = np.array([[f[0], f[j], f[j + 1]] for f in faces for j in range(1, len(f) - 1)])
-        meshio.write(str(path), meshio.Mesh(pts, [("triangle", tris)]))
+        from .surface import ExportError, write_stl
+
+        if os.path.splitext(os.fspath(path))[1].lower() != ".stl":
+            raise ExportError(f"{os.fspath(path)}: ThickMesh.export writes binary STL only "
+                              "(name the file .stl); for other formats use "
+                              "mesh.to_pyvista(positions).save(path)")
+        write_stl(path, self, positions)
 
 
 def surface_faces(mesh: ThickMesh) -> list:

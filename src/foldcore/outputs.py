@@ -9,7 +9,7 @@ import platform
 
 import numpy as np
 
-from .io.fold import CELLS_KEY, HINGE_KEY, POISSON_KEY
+from .io.fold_json import CELLS_KEY, HINGE_KEY, POISSON_KEY
 from .mesh import surface_faces
 
 #: FOLD key marking a result written from an interrupted run's last iterate.
@@ -169,7 +169,7 @@ def hinge_entries(result, pattern, mesh) -> dict:
 
 
 def report_dict(result, pattern, mesh, settings: dict, quantities: dict | None = None) -> dict:
-    """The JSON report of a run (contract in DESIGN.md), plus the settings used.
+    """The JSON report of a run, plus the settings used.
 
     Angles in degrees (valley > 0), lengths mm, times seconds. ``quantities``
     (a scene's own measurements) go under the key ``quantities``.
@@ -210,7 +210,7 @@ def report_dict(result, pattern, mesh, settings: dict, quantities: dict | None =
 
 def write_report(path, report: dict) -> None:
     """Write the report as indented JSON, atomically."""
-    from .io.fold import atomic_write
+    from .files import atomic_write
 
     with atomic_write(path) as fh:
         json.dump(report, fh, indent=1, allow_nan=False)
@@ -259,7 +259,7 @@ def write_result(result, pattern, mesh, thickness: float, settings: dict, *, fol
         (a crease folded past flat on its assigned side, e.g. −180.54°, is written
         −180°; the report keeps the measured value). All or nothing: every
         file is written to a temporary name first and renamed only when all are
-        written (:func:`foldcore.destinations.all_or_nothing`).
+        written (:func:`foldcore.files.all_or_nothing`).
     quantities : dict, optional
         A scene's own measurements, stored in the report.
     partial : bool
@@ -273,7 +273,7 @@ def write_result(result, pattern, mesh, thickness: float, settings: dict, *, fol
         angles and whose ``file_frames`` are :func:`series_frame` of each (the
         last is what ``foldcore render`` draws).
     """
-    from .destinations import all_or_nothing
+    from .files import all_or_nothing
 
     with all_or_nothing({"png": png, "fold": fold, "report": report,
                          "series": series}) as tmp:

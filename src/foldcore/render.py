@@ -36,7 +36,11 @@ import os
 
 import numpy as np
 
+from . import files
 from .errors import FoldcoreError
+from .files import ExportError
+from .mesh import surface_polygons
+from .surface import surface_edges, surface_triangles
 
 HINGE_COLOURS = {"V": (0.20, 0.40, 0.85), "M": (0.85, 0.25, 0.20),
                  "U": (0.95, 0.65, 0.10), "F": (0.60, 0.60, 0.60)}
@@ -192,37 +196,69 @@ def strip_bend_angles(mesh, positions) -> np.ndarray:
 
 
 # ---------------------------------------------------------------- geometry
-def _surface_polydata(mesh, positions):
-    """Outer surface as PolyData sharing ``positions``: panels, hinges, edge lines.
+def surface_polydata(mesh, positions=None, hinges: bool | None = None):
+    """The outer surface of ``mesh`` as a ``pyvista.PolyData`` of triangles.
 
-    Faces are triangulated on the flat footprint (:func:`foldcore.fabrication.
-    surface_triangles`: no slivers at the collinear points panels share with
-    strips) and their polygon edges drawn as lines. The hinge PolyData carries
-    cell data ``strip`` (hinge element index) for per-strip values.
+    The one mesh-to-PyVista conversion: the renders draw it, and
+    :meth:`foldcore.mesh.ThickMesh.to_pyvista` returns it. Faces are
+    triangulated on the flat footprint (:func:`foldcore.surface.surface_triangles`,
+    no slivers at the collinear points panels share with strips).
+
+    Parameters
+    ----------
+    mesh : ThickMesh
+    positions : (N, 3) float, optional
+        Vertex positions, mm (default: rest); the PolyData holds a copy.
+    hinges : bool, optional
+        Only the hinge faces (True) or only the panel faces (False); default all.
+
+    Returns
+    -------
+    pyvista.PolyData or None
+        None when no face is chosen. Cell data per triangle: ``is_hinge`` (bool),
+        ``strip`` (the element index of its prism in its group), ``edge`` (the
+        pattern item the prism came from: face for panels, edge for hinges) and
+        ``bending`` (uint8, 1 on bending-hinge sub-strips).
     """
-    import pyvista as pv
-
-    from .fabrication import surface_edges, surface_polygons, surface_triangles
-
+    x = mesh.rest_positions if positions is None else np.asarray(positions, dtype=float)
     surf = surface_polygons(mesh)
     tris, face = surface_triangles(mesh, surf, return_faces=True)
+    chosen = np.arange(len(tris)) if hinges is None else \
+        np.flatnonzero(surf.is_hinge[face] == hinges)
+    return _polydata(x, surf, tris, face, chosen)
+
+
+def _polydata(x, surf, tris, face, chosen):
+    """PolyData of the triangles ``tris[chosen]`` over a copy of ``x`` (N, 3) mm, with the
+    cell data of :func:`surface_polydata`; None when ``chosen`` is empty."""
+    if not len(chosen):
+        return None
+    pv = require_pyvista(offscreen=False)
+    poly = pv.PolyData(x.copy(), np.column_stack([np.full(len(chosen), 3),
+                                                  tris[chosen]]).ravel())
+    owner = face[chosen]
+    poly.cell_data["strip"] = surf.element[owner]
+    poly.cell_data["edge"] = surf.source[owner]
+    poly.cell_data["bending"] = (surf.group[owner] == "bending_hinge").astype(np.uint8)
+    poly.cell_data["is_hinge"] = surf.is_hinge[owner]
+    return poly
+
+
+def _surface_parts(mesh, positions, source: str | None = None):
+    """(panels, hinges, edge lines) of the outer surface at ``positions`` (N, 3) mm: the
+    panel and hinge triangles as :func:`surface_polydata` (None when there are none)
+    and every polygon edge as a line; ``source``: the file named in errors."""
+    pv = require_pyvista()
+    surf = surface_polygons(mesh)
+    tris, face = surface_triangles(mesh, surf, return_faces=True, source=source)
     x = np.asarray(positions, dtype=float)
-    out = []
-    for is_hinge in (False, True):
-        chosen = np.flatnonzero(surf.is_hinge[face] == is_hinge)
-        if not len(chosen):
-            out.append(None)
-            continue
-        poly = pv.PolyData(x.copy(), np.column_stack([np.full(len(chosen), 3),
-                                                      tris[chosen]]).ravel())
-        poly.cell_data["strip"] = surf.element[face[chosen]]
-        poly.cell_data["edge"] = surf.source[face[chosen]]
-        poly.cell_data["bending"] = (surf.group[face[chosen]] == "bending_hinge").astype(np.uint8)
-        out.append(poly)
+    panels, hinges = (_polydata(x, surf, tris, face,
+                                np.flatnonzero(surf.is_hinge[face] == is_hinge))
+                      for is_hinge in (False, True))
     edges = surface_edges(surf)
     lines = pv.PolyData(x.copy(), lines=np.column_stack([np.full(len(edges), 2),
                                                          edges]).ravel()) if len(edges) else None
-    return out[0], out[1], lines
+    return panels, hinges, lines
 
 
 def _behind_lines(actor) -> None:
@@ -298,13 +334,14 @@ class Renderer:
         self.direction, self.up = view_vectors(view)
         self.pattern, self.mesh = pattern, mesh
         self.padding = float(padding)
-        pv = _pyvista()
+        pv = require_pyvista()
         self.plotter = pv.Plotter(off_screen=True, window_size=list(self.size))
         self.plotter.set_background(BACKGROUND)
         self._box = [0.0, 1.0, 0.0, 1.0]
         self._title = None
         try:
-            self.panels, self.hinges, self.lines = _surface_polydata(mesh, mesh.rest_positions)
+            self.panels, self.hinges, self.lines = _surface_parts(
+                mesh, mesh.rest_positions, getattr(pattern, "source", None))
             self._add_panels()
             self._add_edges()
             if scalars is None:
@@ -411,10 +448,9 @@ class Renderer:
 
     def save(self, path) -> None:
         """Write the current picture as PNG at ``path``, atomically."""
-        from .fabrication import atomic_path
-
+        files.check_folder(path, ExportError)
         self.plotter.render()
-        with atomic_path(path, suffix=".png") as tmp:
+        with files.atomic_path(path, suffix=".png") as tmp:
             self.plotter.screenshot(tmp)
 
     def close(self) -> None:
@@ -474,14 +510,16 @@ def render_png(pattern, mesh, positions, path, size=(1024, 768), view="iso",
         r.save(path)
 
 
-def _pyvista():
-    """pyvista set up for offscreen rendering; EGL directly when there is no display."""
-    if not os.environ.get("DISPLAY"):
+def require_pyvista(offscreen: bool = True):
+    """pyvista (RenderError naming the extra when missing); ``offscreen``: set up for
+    offscreen rendering, EGL directly when there is no display."""
+    if offscreen and not os.environ.get("DISPLAY"):
         # without this VTK first tries X, fails with a warning, then falls back to EGL
         os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
     try:
         import pyvista as pv
     except ImportError:
         raise RenderError("rendering needs pyvista: pip install 'foldcore[render]'") from None
-    pv.OFF_SCREEN = True
+    if offscreen:
+        pv.OFF_SCREEN = True
     return pv

@@ -11,7 +11,7 @@ angle (valley blue, mountain red), and each hinge sub-strip's larger surface
 strain (dark to yellow, 0 to the largest over the frames; as ``foldcore render
 --color-by strain``). ``#frame=K&colour=angle`` in the URL
 chooses the first view (used by the tests). Geometry: the outer surface of
-the thick mesh rebuilt from the file (:func:`foldcore.fabrication.read_result`),
+the thick mesh rebuilt from the file (:func:`foldcore.result_file.read_result`),
 float32 positions per frame, base64-encoded.
 """
 from __future__ import annotations
@@ -37,15 +37,17 @@ def view_html(path, output) -> None:
         ``path`` is not a result file foldcore can rebuild, or a folded frame does
         not match the rebuilt mesh.
     """
-    from .fabrication import read_result, surface_triangles
-    from .io.fold import atomic_write, read_bytes
+    from .files import write_text
+    from .io.fold import read_bytes
     from .mesh import surface_polygons
+    from .result_file import read_result
+    from .surface import surface_triangles
 
     source = os.fspath(path)
     res = read_result(source)
     d = json.loads(read_bytes(source))
     surface = surface_polygons(res.mesh)
-    triangles, face = surface_triangles(res.mesh, surface, return_faces=True)
+    triangles, face = surface_triangles(res.mesh, surface, return_faces=True, source=source)
     crease = np.where(surface.is_hinge[face], surface.source[face], -1).astype(np.int32)
     kind = np.zeros(len(triangles), dtype=np.uint8)
     hinge = crease >= 0
@@ -64,8 +66,7 @@ def view_html(path, output) -> None:
         "three": _module_url("three.module.min.js"),
         "three/addons/controls/OrbitControls.js": _module_url("OrbitControls.js")}}))
     page = page.replace("__DATA__", json.dumps(data))
-    with atomic_write(output) as fh:
-        fh.write(page)
+    write_text(output, page)
 
 
 def _strip_strains(mesh, positions: np.ndarray) -> np.ndarray:

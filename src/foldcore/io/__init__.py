@@ -1,5 +1,6 @@
 """Crease-pattern files: FOLD (the ecosystem's format), SVG in Origami Simulator's
-colours, and the paper's OBJ/STL + hinge file. Lengths are mm, angles degrees (valley positive) once read.
+colours, and the paper's OBJ/STL + hinge file. Lengths are mm, angles degrees
+(valley positive) once read; :func:`read_file` chooses the reader.
 
 >>> pattern = read("bird.fold")                      # doctest: +SKIP
 >>> pattern = read("sheet.obj", hinges="sheet.hinges")  # doctest: +SKIP
@@ -16,15 +17,27 @@ from .fold import (MAX_FILE_BYTES, FoldFile, fold_dict, pattern_from_fold_dict, 
                    read_fold_file, write_fold)
 from .obj import mesh_edges, read_mesh, write_hinges, write_obj
 
-__all__ = ["MAX_FILE_BYTES", "FoldFile", "Reading", "fold_dict", "mesh_edges", "pattern_from_fold_dict",
-           "read", "read_fold", "read_fold_file", "read_mesh", "write_fold", "write_hinges",
-           "write_obj"]
+__all__ = ["MAX_FILE_BYTES", "FoldFile", "Reading", "fold_dict", "mesh_edges",
+           "pattern_from_fold_dict", "read", "read_file", "read_fold", "read_fold_file",
+           "read_mesh", "write_fold", "write_hinges", "write_obj"]
 
 MESH_SUFFIXES = (".obj", ".stl")
 
 
 def read(path, *, hinges=None, reading: Reading | None = None) -> CreasePattern:
-    """Read a crease pattern, choosing the reader by the file suffix.
+    """Read a crease pattern, choosing the reader by the file suffix (:func:`read_file`).
+
+    Returns
+    -------
+    CreasePattern
+        Lengths in mm, angles in degrees. For a FOLD file's
+        ``foldcore:thickness`` and other file-level values use :func:`read_file`.
+    """
+    return read_file(path, hinges=hinges, reading=reading).pattern
+
+
+def read_file(path, *, hinges=None, reading: Reading | None = None) -> FoldFile:
+    """Read a crease-pattern file of any kind: the one place that dispatches on the suffix.
 
     Parameters
     ----------
@@ -33,35 +46,39 @@ def read(path, *, hinges=None, reading: Reading | None = None) -> CreasePattern:
         :mod:`.svg`), or ``.obj`` / ``.stl`` (2D polygon mesh, mm).
     hinges : str or os.PathLike, optional
         Hinge file of a mesh; default: the mesh path with suffix ``.hinges``.
-        Not allowed with ``.fold``.
+        Only with an OBJ/STL mesh.
     reading : Reading, optional
-        How a FOLD file is read (conventions, scaling; :mod:`.conventions`).
+        How the file is read (conventions, scaling; :mod:`.conventions`); an
+        OBJ/STL mesh is read in mm, so it takes no ``scale`` or ``size``.
 
     Returns
     -------
-    CreasePattern
-        Lengths in mm, angles in degrees. For a FOLD file's
-        ``foldcore:thickness`` use :func:`read_fold_file`.
+    FoldFile
+        The pattern (lengths mm, angles degrees) and, for a FOLD file, its
+        thickness, unit, stiffness factors and hinge models (None otherwise;
+        ``frame_unit`` "mm" for SVG and meshes, whose lengths are mm once read).
 
     Raises
     ------
     PatternError
-        Unknown suffix, missing hinge file, or any malformed input.
+        Unknown suffix, a hinge file or a scale given where it does not apply,
+        missing hinge file, or any malformed input.
     """
     source = os.fspath(path)
     suffix = Path(source).suffix.lower()
+    reading = Reading() if reading is None else reading
+    if suffix in (".fold", ".svg") and hinges is not None:
+        raise PatternError(f"{source}: a hinge file only goes with an OBJ/STL mesh, "
+                           f"not {'a FOLD file' if suffix == '.fold' else 'an SVG'}")
     if suffix == ".fold":
-        if hinges is not None:
-            raise PatternError(f"{source}: a hinge file only goes with an OBJ/STL mesh, "
-                               "not a FOLD file")
-        return read_fold(source, reading)
+        return read_fold_file(source, reading)
     if suffix == ".svg":
         from .svg import read_svg  # svgelements only when an SVG is read
-        if hinges is not None:
-            raise PatternError(f"{source}: a hinge file only goes with an OBJ/STL mesh, "
-                               "not an SVG")
-        return read_svg(source, reading)
+        return FoldFile(read_svg(source, reading), None, "mm")
     if suffix in MESH_SUFFIXES:
-        return read_mesh(source, hinges)
+        if reading.scale is not None or reading.size is not None:
+            raise PatternError(f"{source}: a scale or sheet size applies to FOLD and SVG "
+                               "patterns; an OBJ/STL mesh is read in mm")
+        return FoldFile(read_mesh(source, hinges), None, "mm")
     raise PatternError(f"{source}: unknown crease-pattern file type {suffix or '(no suffix)'!r}"
                        " (expected .fold, .svg, .obj or .stl)")

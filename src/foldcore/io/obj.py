@@ -51,15 +51,16 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import limits
+from .. import files, limits
 from ..errors import PatternError
 from ..pattern import DEFAULT_MAX_ANGLE_DEG, CreasePattern
 from ..planar import loop_starts, next_in_loop
-from .fold import _build, _short, atomic_write, read_bytes
+from .fold import build_pattern, read_bytes
+from .fold_json import short
 
 HINGE_SUFFIX = ".hinges"
 HINGE_KINDS = ("M", "V", "F", "U")
-_STL_RECORD = np.dtype([("normal", "<f4", 3), ("v", "<f4", (3, 3)), ("attr", "<u2")])
+STL_RECORD = np.dtype([("normal", "<f4", 3), ("v", "<f4", (3, 3)), ("attr", "<u2")])
 
 
 def mesh_edges(faces) -> np.ndarray:
@@ -192,7 +193,7 @@ def _obj_vertex(tokens: list[str], where: str) -> tuple[float, float]:
     xyz = [_float(t) for t in tokens[1:4]]
     if len(xyz) < 2 or None in xyz:
         raise PatternError(f"{where}: expected 'v x y [z]' with finite numbers, "
-                           f"got {_short(' '.join(tokens))}")
+                           f"got {short(' '.join(tokens))}")
     if len(xyz) == 3 and xyz[2] != 0:
         raise PatternError(f"{where}: vertex has z = {xyz[2]:g}; the pattern must lie "
                            "flat in the plane z = 0")
@@ -203,7 +204,7 @@ def _obj_face(tokens: list[str], n_read: int, where: str) -> list[int]:
     ids = [_int(t.split("/", 1)[0]) for t in tokens[1:]]
     if len(ids) < 3 or None in ids or 0 in ids:
         raise PatternError(f"{where}: expected 'f i j k ...' with at least 3 non-zero "
-                           f"vertex ids (1-based), got {_short(' '.join(tokens))}")
+                           f"vertex ids (1-based), got {short(' '.join(tokens))}")
     return [i - 1 if i > 0 else n_read + i for i in ids]
 
 
@@ -211,7 +212,7 @@ def parse_stl(data: bytes, source: str) -> tuple[np.ndarray, list[np.ndarray]]:
     """Vertices ((V, 2), mm; coincident ones merged) and faces of an STL file."""
     count = int.from_bytes(data[80:84], "little")
     if len(data) >= 84 and len(data) == 84 + 50 * count:
-        records = np.frombuffer(data, dtype=_STL_RECORD, count=count, offset=84)
+        records = np.frombuffer(data, dtype=STL_RECORD, count=count, offset=84)
         return _merge_triangles(records["v"].astype(np.float64), source)
     if b"\0" in data:  # ASCII STL is text: a damaged binary STL
         _bad_binary_stl(data, count, source)
@@ -244,7 +245,7 @@ def _ascii_stl_loops(text: str, source: str) -> list[tuple[str, list]]:
             xyz = [_float(t) for t in tokens[1:]]
             if current is None or len(xyz) != 3 or None in xyz:
                 raise PatternError(f"{where}: expected 'vertex x y z' inside "
-                                   f"'outer loop', got {_short(' '.join(tokens))}")
+                                   f"'outer loop', got {short(' '.join(tokens))}")
             current[1].append(xyz)
         elif word == "endloop" and current is not None:
             loops.append(current)
@@ -319,7 +320,7 @@ def parse_hinges(text: str, source: str, n_edges: int) -> dict[int, tuple]:
 def _hinge_line(tokens: list[str], n_edges: int, where: str) -> tuple:
     if len(tokens) < 3:
         raise PatternError(f"{where}: expected 'edge_id width M|V [bend_angle_deg]', "
-                           f"got {_short(' '.join(tokens))}")
+                           f"got {short(' '.join(tokens))}")
     edge = _int(tokens[0])
     if edge is None or not 0 <= edge < n_edges:
         raise PatternError(f"{where}: edge id {tokens[0]!r} is not an edge of the mesh "
@@ -390,8 +391,9 @@ def pattern_from_mesh(vertices, faces, hinges: dict, source: str) -> CreasePatte
         raise PatternError(f"{source}: interior edge {missing[0]} has no hinge line "
                            f"({len(missing)} missing); every interior edge needs one, since "
                            "the panels are the mesh faces")
-    return _build(dict(vertices=vertices, edges=edges, assignments=kinds, fold_angles=angles,
-                       widths=widths, max_angles=max_angles, faces=faces, source=source))
+    return build_pattern(dict(vertices=vertices, edges=edges, assignments=kinds,
+                              fold_angles=angles, widths=widths, max_angles=max_angles,
+                              faces=faces, source=source))
 
 
 def _check_widths(vertices, hinges: dict, source: str) -> None:
@@ -436,7 +438,7 @@ def write_obj(path, pattern: CreasePattern) -> None:
     Full float precision, so :func:`read_mesh` gives back the same vertices.
     Write the hinges with :func:`write_hinges`.
     """
-    with atomic_write(path) as fh:
+    with files.atomic_write(path) as fh:
         fh.write("# foldcore crease pattern: 2D polygon mesh, mm (hinges: .hinges file)\n")
         for x, y in pattern.vertices.tolist():
             fh.write(f"v {x!r} {y!r} 0\n")
@@ -447,7 +449,7 @@ def write_obj(path, pattern: CreasePattern) -> None:
 def write_hinges(path, pattern: CreasePattern) -> None:
     """Write one hinge line per crease, in :func:`mesh_edges` numbering, atomically."""
     lookup = {(min(a, b), max(a, b)): e for e, (a, b) in enumerate(pattern.edges.tolist())}
-    with atomic_write(path) as fh:
+    with files.atomic_write(path) as fh:
         fh.write("# foldcore hinge file: edge_id width(mm|auto) M|V|F|U [angle_deg] "
                  "[max=deg]\n# edge ids: unique face sides in order of first appearance\n")
         for i, (a, b) in enumerate(mesh_edges(pattern.faces).tolist()):
