@@ -147,12 +147,13 @@ class Record:
                      "command": " ".join(["python", *sys.argv]).replace(str(ROOT) + "/", ""),
                      "quick": bool(args.quick), **settings}
 
-    def write(self, data: dict, plot=None) -> Path:
-        """``{"meta": ..., **data}`` as NAME.json, then ``plot(json_dict, NAME.png)``."""
+    def write(self, data: dict, plot=None, indent: int | None = 1) -> Path:
+        """``{"meta": ..., **data}`` as NAME.json (``indent`` None: compact, for long
+        curves), then ``plot(json_dict, NAME.png)``."""
         self.meta["load_after"] = list(os.getloadavg())
         path = self.out / f"{self.name}.json"
         document = {"meta": self.meta, **data}
-        path.write_text(json.dumps(document, indent=1))
+        path.write_text(json.dumps(document, indent=indent))
         if plot is not None:
             plot(document, path.with_suffix(".png"))
         print(f"wrote {path}" + (f" and {path.with_suffix('.png').name}" if plot else ""),

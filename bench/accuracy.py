@@ -21,7 +21,8 @@ hinge model (axis, arc, eq8), strategy (hybrid, rigid, lbfgs), actuation
 (one warm-up fold per model and strategy first), median of RUNS runs (one
 for Miura 20 × 20), the configurations of one case interleaved round by
 round. The ``size`` sweep also records error vs strategy time (set-up +
-projection + solve of ``Simulation.timings``) along each run (``trace``).
+projection + solve of ``Simulation.timings``) along each run (``trace``,
+ending with the run's result, as in ``convergence.py``).
 Writes bench/results/accuracy.json and .png.
 
 Run: ``python bench/accuracy.py`` (~10 min) or ``--quick``; ``--table`` prints
@@ -92,6 +93,10 @@ def fold(scene, model: str, strategy: str, actuation: str = "equal", budget: int
                      callback=record if trace_every else None)
     seconds = time.perf_counter() - start
     error = float(np.abs(result.fold_angles_deg[creases] - expected).max())
+    if trace_every:
+        from convergence import with_end
+
+        trace = with_end(trace, result, expected, creases)
     return {"error_deg": error, "iterations": int(result.iterations),
             "converged": bool(result.converged), "seconds": seconds,
             "largest_misfit_mm": float(result.hinge_misfit_mm.max()), "trace": trace}
@@ -212,7 +217,7 @@ def main() -> None:
                           tolerance=TOLERANCE, budget=BUDGET, budget_lbfgs_miura_20=2_000,
                           others_busy_before=_meta.others_busy())
     data = sweeps(q)
-    record.write(data, plot)
+    record.write(data, plot, indent=None)
     print(table(data))
 
 
