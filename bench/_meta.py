@@ -44,6 +44,7 @@ def parser(doc: str) -> argparse.ArgumentParser:
                         f"{QUICK_RESULTS})")
     p.add_argument("--table", action="store_true",
                    help="print the Markdown table of docs/benchmarks.md from the stored JSON")
+    p.add_argument("--plot", action="store_true", help="redraw the PNG from the stored JSON")
     return p
 
 
@@ -58,6 +59,21 @@ def load_json(name: str, args=None) -> dict:
     """The stored ``name``.json (bench/results/, or ``--out`` when given)."""
     folder = args.out if args is not None and args.out is not None else RESULTS
     return json.loads((folder / f"{name}.json").read_text())
+
+
+def stored(name: str, args, table=None, plot=None) -> bool:
+    """``--table`` / ``--plot``: print the table of, or redraw the PNG of, the stored
+    ``name``.json; returns whether one was asked for (then there is nothing to run)."""
+    if not (args.table or args.plot):
+        return False
+    data = load_json(name, args)
+    if args.table and table is not None:
+        print(table(data))
+    if args.plot and plot is not None:
+        path = (args.out or RESULTS) / f"{name}.png"
+        plot(data, path)
+        print(f"wrote {path}")
+    return True
 
 
 # ------------------------------------------------------------------ machine and load

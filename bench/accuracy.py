@@ -205,8 +205,7 @@ def table(data: dict) -> str:
 
 def main() -> None:
     args = _meta.parser(__doc__).parse_args()
-    if args.table:
-        print(table(_meta.load_json("accuracy", args)))
+    if _meta.stored("accuracy", args, table, plot):
         return
     q = QUICK if args.quick else {"runs": RUNS, "models": MODELS, "strategies": STRATEGIES,
                                   "width": WIDTH_RATIOS, "thickness": THICKNESS_RATIOS,

@@ -242,8 +242,7 @@ def table(document: dict) -> str:
 
 def main() -> None:
     args = _meta.parser(__doc__).parse_args()
-    if args.table:
-        print(table(_meta.load_json("convergence", args)))
+    if _meta.stored("convergence", args, table, plot):
         return
     for solver in ("rigid", "paper", "anderson", "lbfgs"):  # warm-up: numba cache, first factor
         trace(hinge_scene(5.0), solver, 5)

@@ -118,8 +118,7 @@ def plot(data: dict, path_png) -> None:
 
 def main() -> None:
     args = _meta.parser(__doc__).parse_args()
-    if args.table:
-        print(table(_meta.load_json("paths", args)))
+    if _meta.stored("paths", args, table, plot):
         return
     runs, frames = (QUICK_RUNS, QUICK_FRAMES) if args.quick else (RUNS, FRAMES)
     record = _meta.Record("paths", args, runs=runs, warmup_rounds=1, frames=frames,

@@ -235,9 +235,8 @@ def memory_table(data: dict) -> str:
 
 def main() -> None:
     args = _meta.parser(__doc__).parse_args()
-    if args.table:
-        data = _meta.load_json("time_to_solution", args)
-        print(table(data) + "\n\n" + memory_table(data))
+    if _meta.stored("time_to_solution", args,
+                    lambda data: table(data) + "\n\n" + memory_table(data), plot):
         return
     q = QUICK if args.quick else {"cases": CASES, "runs": RUNS, "lbfgs_budget": LBFGS_BUDGET,
                                   "memory": MEMORY_CASES}
