@@ -147,7 +147,7 @@ def wait_for_quiet(below: float = 0.25, patience_s: float = 300.0) -> float:
     """Wait (up to ``patience_s``) until other jobs use < ``below`` of the cores;
     returns the last share measured."""
     deadline = time.perf_counter() + patience_s
-    busy = others_busy()
+    busy = others_busy(min(2.0, max(patience_s, 0.5)))
     while busy > below and time.perf_counter() < deadline:
         busy = others_busy(5.0)
     return busy
