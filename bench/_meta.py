@@ -236,6 +236,12 @@ def median_run(rows: list, key: str = "seconds") -> dict:
 
 
 # ------------------------------------------------------------------ output
+def sig(value: float, digits: int = 3) -> str:
+    """``value`` to ``digits`` significant digits, without an exponent from 1 to 10⁶."""
+    text = f"{value:.{digits}g}"
+    return f"{value:,.0f}" if "e" in text and 1 <= abs(value) < 1e6 else text
+
+
 def markdown_table(header: list, rows: list) -> str:
     """A Markdown table from a header row and rows of cell strings."""
     lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
