@@ -1,4 +1,4 @@
-"""Mutation run: do the fast tests catch hand-written bugs in kernels and readers?
+"""Mutation run: do the fast tests catch hand-written bugs in kernels and readers? (a dev tool)
 
 Each mutant replaces one exact snippet of one source file (the snippet must occur
 once) in a *temporary copy* of ``src/`` and ``tests/`` — never the working tree —
@@ -12,9 +12,10 @@ arithmetic). The others run compiled: the copy keeps ``__pycache__``, and numba'
 cache (keyed on each file's content) stays valid for the files not mutated. An
 unmutated baseline of every subset must pass first.
 
-Writes ``bench/results/mutation.json``. Usage::
+Writes ``tools/results/mutation.json`` (~10 min on 2 cores). Usage::
 
-    PYTHONPATH=src python bench/mutation.py [--only ID,ID --out FILE]
+    python tools/mutation.py [--only ID,ID --out FILE]
+    python tools/mutation.py --check   # every snippet still found once (after a refactor)
 """
 from __future__ import annotations
 
@@ -31,7 +32,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-OUT = ROOT / "bench" / "results" / "mutation.json"
+OUT = ROOT / "tools" / "results" / "mutation.json"
 TIMEOUT_S = 300
 
 SUBSETS = {  # name: (test files, run kernels as plain Python)
@@ -195,11 +196,19 @@ def main(argv=None) -> int:
     parser.add_argument("--only", help="comma-separated mutant ids")
     parser.add_argument("--out", type=Path, default=OUT,
                         help="JSON written (with --only: only when given)")
+    parser.add_argument("--check", action="store_true",
+                        help="only check that every mutant's snippet occurs once in its file")
     args = parser.parse_args(argv)
     mutants = MUTANTS
     if args.only:
         wanted = set(args.only.split(","))
         mutants = [m for m in MUTANTS if m.id in wanted]
+    if args.check:
+        found = {m.id: (ROOT / m.file).read_text().count(m.original)
+                 if (ROOT / m.file).exists() else 0 for m in mutants}
+        stale = [f"{m.id}: {found[m.id]} times in {m.file}" for m in mutants if found[m.id] != 1]
+        print("\n".join(stale) or f"all {len(mutants)} snippets found once")
+        return 1 if stale else 0
     load = [os.getloadavg()[0]]
     start = time.perf_counter()
     baseline = {}
@@ -222,12 +231,12 @@ def main(argv=None) -> int:
     if args.only and args.out == OUT:
         return 0
     sys.path.insert(0, str(ROOT / "bench"))
-    from _meta import machine_meta
+    import _meta
 
     commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, text=True,
                             capture_output=True, check=False).stdout.strip()
     args.out.write_text(json.dumps({
-        "meta": {**machine_meta(), "date": time.strftime("%Y-%m-%d"), "commit": commit,
+        "meta": {**_meta.machine(), "commit": commit,
                  "load_average_1min": load, "timeout_s": TIMEOUT_S,
                  "total_seconds": round(time.perf_counter() - start, 1),
                  "subsets": {k: {"tests": v[0], "numba_disable_jit": v[1]}
