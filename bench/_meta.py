@@ -69,6 +69,7 @@ def stored(name: str, args, table=None, plot=None) -> bool:
     data = load_json(name, args)
     if args.table and table is not None:
         print(table(data))
+        print(f"\n{machine_line(meta_of(data))}")
     if args.plot and plot is not None:
         path = (args.out or RESULTS) / f"{name}.png"
         plot(data, path)

@@ -189,7 +189,8 @@ def summary(points: list, result, totals: list) -> dict:
 
 
 def reference(make):
-    """A rigid run converged to a 1e-13 step: the thick model's own answer, beside the closed form."""
+    """A rigid run converged to a 1e-13 step: the thick model's own answer, beside the
+    closed form."""
     pattern, mesh, expected, creases = make()
     sim = Simulation(mesh, pattern, solver="rigid")
     ref = sim.run(tolerance=1e-13, max_iterations=500)

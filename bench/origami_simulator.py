@@ -29,10 +29,10 @@ same run*. This benchmark runs both, interleaved, ``ROUNDS`` rounds:
   line by ``patterns.miura_flat_widths`` — the widths that let a thick Miura
   fold flat: docs/design.md#a-thick-miura-has-no-flat-state-with-equal-hinges
   — every crease driven to its rigid-fold angle at facet tilt 90°, default
-  strategy, tolerance 1e-9), warm numba cache, one warm-up fold in this process first; ``seconds`` is
-  ``Simulation(...).run()`` (the mesh is built once, outside the timing, as
-  for Origami Simulator's page load). Its misses: the largest on the
-  straight and on the zig-zag creases (degrees).
+  strategy, tolerance 1e-9), warm numba cache, one warm-up fold in this
+  process first; ``seconds`` is ``Simulation(...).run()`` (the mesh is built
+  once, outside the timing, as for Origami Simulator's page load). Its
+  misses: the largest on the straight and on the zig-zag creases (degrees).
 
 Reported per round: both times, their ratio (Origami Simulator / foldcore),
 Origami Simulator's steps, strain and angle error at each threshold, and

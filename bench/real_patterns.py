@@ -105,14 +105,19 @@ def cases(elastic: bool, quick: bool, runs: int) -> list:
     return out
 
 
+def short(message: str, limit: int = 80) -> str:
+    """``message`` cut at a word before ``limit`` characters, with an ellipsis."""
+    return message if len(message) <= limit else message[:limit].rsplit(" ", 1)[0] + " …"
+
+
 def table(data: dict) -> str:
     rows = []
     for c in data["cases"]:
         if "skipped" in c:
-            rows.append([c["file"], "—", "skipped: " + c["skipped"].replace(" (issue 17)", ""),
+            rows.append([c["file"], "—", "skipped: " + c["skipped"].split(" (")[0],
                          "", "", "", ""])
         elif "refused" in c:
-            rows.append([c["file"], "—", "refused: " + c["refused"].split(": ", 1)[-1][:90],
+            rows.append([c["file"], "—", "refused: " + short(c["refused"].split(": ", 1)[-1]),
                          "", "", "", ""])
         else:
             verdict = "converged" if c["converged"] else c["reason"]

@@ -223,6 +223,14 @@ def table(data: dict) -> str:
                                  "kB / thick vertex (hybrid)"], rows)
 
 
+def cold_line(data: dict) -> str:
+    """The cold-cache run, when measured."""
+    c = data.get("cold")
+    return "" if c is None else (f"cold numba cache ({c['case']}, {c['strategy']}, everything "
+                                 f"compiled in the process): {c['seconds']:.3g} s, "
+                                 f"{c['iterations']} iterations")
+
+
 def memory_table(data: dict) -> str:
     """Fixed MB, marginal MB and kB per thick vertex of the memory probes."""
     return _meta.markdown_table(
@@ -235,8 +243,8 @@ def memory_table(data: dict) -> str:
 
 def main() -> None:
     args = _meta.parser(__doc__).parse_args()
-    if _meta.stored("time_to_solution", args,
-                    lambda data: table(data) + "\n\n" + memory_table(data), plot):
+    if _meta.stored("time_to_solution", args, lambda data: "\n\n".join(
+            [table(data), cold_line(data), memory_table(data)]), plot):
         return
     q = QUICK if args.quick else {"cases": CASES, "runs": RUNS, "lbfgs_budget": LBFGS_BUDGET,
                                   "memory": MEMORY_CASES}
@@ -260,7 +268,7 @@ def main() -> None:
     print("memory", flush=True)
     data["memory"] = {"rows": [child("--memory-probe", case) for case in q["memory"]]}
     record.write(data, plot)
-    print(table(data) + "\n\n" + memory_table(data))
+    print("\n\n".join([table(data), cold_line(data), memory_table(data)]))
 
 
 if __name__ == "__main__":
