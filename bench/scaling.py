@@ -38,7 +38,7 @@ Before each size the parent waits (up to QUIET_WAIT_S) until other jobs use
 all cores other processes used while the size ran). Exponents: log-log least
 squares of time vs thick-mesh vertices over the sizes with n ≥ FIT_FROM_N.
 ``--threads`` gives every Simulation that many numba threads (default: the
-library's choice).
+library's choice); ``--child n`` prints one size's JSON row.
 
 Run: ``python bench/scaling.py`` (all sizes: ~25 min and 8 GB at 400 × 400 on
 2 cores), ``--sizes 5 10 20`` (a subset) or ``--quick``; writes
@@ -280,11 +280,12 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    if sys.argv[1:2] == ["--child"]:
-        threads = int(sys.argv[3]) or None
+    if sys.argv[1:2] == ["--child"]:  # --child n [threads] [--quick]: one size's JSON row
+        numbers = [a for a in sys.argv[2:] if not a.startswith("--")]
+        threads = int(numbers[1]) if len(numbers) > 1 and int(numbers[1]) else None
         q = QUICK if "--quick" in sys.argv else {"setup_runs": SETUP_RUNS,
                                                  "iterations": ITERATIONS,
                                                  "min_iterations": MIN_ITERATIONS}
-        print(json.dumps(child(int(sys.argv[2]), threads, q)), flush=True)
+        print(json.dumps(child(int(numbers[0]), threads, q)), flush=True)
     else:
         main()
