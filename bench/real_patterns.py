@@ -55,6 +55,22 @@ def wrong_side(assignments, angles) -> int:
                                 | (assignments == "V") & (a < -1.0)))
 
 
+def simulate(path, percent: float, elastic_cells, budget: int):
+    """:func:`foldcore.simulate` of ``path`` with this benchmark's settings, in its grouped
+    options (``reading``, ``thickening``, ``solving``) or, in a foldcore without them, its
+    keyword options."""
+    import inspect
+
+    import foldcore
+
+    if "solving" in inspect.signature(foldcore.simulate).parameters:
+        return foldcore.simulate(path, reading={"size": SHEET},
+                                 thickening={"thickness": H, "elastic_cells": elastic_cells},
+                                 solving={"fold_percent": percent, "max_iterations": budget})
+    return foldcore.simulate(path, thickness=H, sheet_size=SHEET, fold_percent=percent,
+                             max_iterations=budget, elastic_cells=elastic_cells)
+
+
 def run_one(path, percent: float, elastic_cells=None, budget=BUDGET) -> dict:
     """One fold of ``path`` through :func:`foldcore.simulate` (module docstring)."""
     import foldcore
@@ -63,9 +79,7 @@ def run_one(path, percent: float, elastic_cells=None, budget=BUDGET) -> dict:
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         try:
-            result = foldcore.simulate(path, thickness=H, sheet_size=SHEET,
-                                       fold_percent=percent, max_iterations=budget,
-                                       elastic_cells=elastic_cells)
+            result = simulate(path, percent, elastic_cells, budget)
         except foldcore.FoldcoreError as exc:
             return {"refused": str(exc).replace(str(path), path.name), "seconds": 0.0}
         seconds = time.perf_counter() - start

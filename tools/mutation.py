@@ -16,6 +16,9 @@ Writes ``tools/results/mutation.json`` (~10 min on 2 cores). Usage::
 
     python tools/mutation.py [--only ID,ID --out FILE]
     python tools/mutation.py --check   # every snippet still found once (after a refactor)
+
+A mutant whose file no longer holds its snippet is applied to the one file of
+src/ that holds it once (a refactor moved the code); ``--check`` lists those.
 """
 from __future__ import annotations
 
@@ -140,6 +143,19 @@ MUTANTS = [
 ]
 
 
+def locate(root: Path, mutant: Mutant) -> tuple[str | None, int]:
+    """The file under ``root`` holding ``mutant``'s snippet exactly once: its own
+    ``file``, else the one file of src/ that does (a refactor moved it); and how many
+    times the snippet occurs in the named file."""
+    named = root / mutant.file
+    count = named.read_text().count(mutant.original) if named.exists() else 0
+    if count == 1:
+        return mutant.file, count
+    found = [p for p in sorted((root / "src").rglob("*.py"))
+             if p.read_text().count(mutant.original) == 1]
+    return (str(found[0].relative_to(root)) if len(found) == 1 else None), count
+
+
 def make_copy(mutant: Mutant | None) -> Path:
     """Temporary root holding src/ (with its __pycache__), tests/, examples/ (the
     element tests register its plugin) and pyproject.toml, ``mutant`` applied."""
@@ -149,13 +165,13 @@ def make_copy(mutant: Mutant | None) -> Path:
     shutil.copytree(ROOT / "examples", root / "examples")
     shutil.copy(ROOT / "pyproject.toml", root)
     if mutant is not None:
-        path = root / mutant.file
-        text = path.read_text()
-        if text.count(mutant.original) != 1:
+        where, count = locate(root, mutant)
+        if where is None:
             shutil.rmtree(root)
-            raise SystemExit(f"mutant {mutant.id}: snippet found {text.count(mutant.original)} "
-                             f"times in {mutant.file} (needs exactly 1)")
-        path.write_text(text.replace(mutant.original, mutant.replacement))
+            raise SystemExit(f"mutant {mutant.id}: snippet found {count} times in "
+                             f"{mutant.file} and in no other one file of src/ (needs exactly 1)")
+        path = root / where
+        path.write_text(path.read_text().replace(mutant.original, mutant.replacement))
     return root
 
 
@@ -204,10 +220,12 @@ def main(argv=None) -> int:
         wanted = set(args.only.split(","))
         mutants = [m for m in MUTANTS if m.id in wanted]
     if args.check:
-        found = {m.id: (ROOT / m.file).read_text().count(m.original)
-                 if (ROOT / m.file).exists() else 0 for m in mutants}
-        stale = [f"{m.id}: {found[m.id]} times in {m.file}" for m in mutants if found[m.id] != 1]
-        print("\n".join(stale) or f"all {len(mutants)} snippets found once")
+        where = {m.id: locate(ROOT, m) for m in mutants}
+        stale = [f"{m.id}: {where[m.id][1]} times in {m.file}, in no other one file"
+                 for m in mutants if where[m.id][0] is None]
+        moved = [f"{m.id}: {m.file} -> {where[m.id][0]}" for m in mutants
+                 if where[m.id][0] not in (None, m.file)]
+        print("\n".join(stale + moved) or f"all {len(mutants)} snippets found once")
         return 1 if stale else 0
     load = [os.getloadavg()[0]]
     start = time.perf_counter()
