@@ -1,8 +1,9 @@
 # Set-up, main job and tests of foldcore on a fresh Debian machine.
 #   make demo    fold the built-in scenes, write FOLD + PNG + JSON to out/
 #   make test    run the test suite
-#   make bench   run the benchmarks (results in bench/results/; installs the
-#                bench extra, PyAMG, first)
+#   make bench   run the benchmarks (results in bench/results/; the full set
+#                takes long: QUICK=1 runs small sizes and few runs, results in a
+#                temp folder; what each measures: docs/benchmarks.md)
 # Both demo and test do all set-up first: system library for CHOLMOD (when
 # root), a virtual environment in .venv, the package with its extras, and the
 # default path's numba kernels compiled once (foldcore.warmup), so the first
@@ -40,8 +41,7 @@ test: setup
 	$(PY) -m pytest -q
 
 bench: setup
-	$(PY) -m pip install --quiet -e ".[bench]"
-	$(PY) bench/run.py
+	$(PY) bench/run.py $(if $(QUICK),--quick)
 
 clean:
 	rm -rf $(VENV) $(OUT) .pytest_cache .hypothesis

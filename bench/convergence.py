@@ -28,29 +28,30 @@ strategies run their whole budget (tolerance 0), because the step-size rule
 stops slow strategies early (on the thin vertex L-BFGS "converged" after 40
 iterations with 60° left, measured). Time = the strategy's own time (setup
 + projection + solve from ``Simulation.timings``), so measuring the error in
-the callback does not count. Budget per scene in SCENES (20 000
-iterations, fewer on the Miura sheets; rigid: 200); the rigid and hybrid
-curves are the median-time run of RUNS runs, the others one run.
+the callback does not count; each curve ends with the run's result (the
+rigid-body strategies step the mesh's coarse twin and move the mesh only
+where they hand over or end, so their curves are flat until then). Budget
+per scene in SCENES (20 000 iterations, fewer on the Miura sheets; rigid:
+200); the rigid and hybrid
+curves are the median-time run of RUNS runs, the others one run; the first
+round runs every strategy, one after another, the others rigid and hybrid
+(warm numba cache: each strategy folds a small hinge first).
 Writes bench/results/convergence.json and .png; ``--table`` prints the
-README's table from the JSON.
+table of docs/benchmarks.md from the JSON.
+
+Run: ``python bench/convergence.py`` (~20 min) or ``--quick`` (two scenes,
+small budgets, one run).
 """
 from __future__ import annotations
 
-import json
-import os
 import statistics
-import sys
-from pathlib import Path
 
 import numpy as np
 
-from foldcore import kinematics, patterns, thicken
-from foldcore.simulation import Simulation
+from foldcore import Simulation, kinematics, patterns, thicken
 
-from _meta import machine_meta, markdown_table
-from scaling import others_busy
+import _meta
 
-RESULTS = Path(__file__).parent / "results"
 RUNS = 3
 RIGID_BUDGET = 200
 SOLVERS = ("hybrid", "rigid", "lbfgs", "anderson", "paper")
@@ -58,6 +59,8 @@ STYLE = {"paper": "C0-", "anderson": "C1-", "lbfgs": "C2-", "rigid": "C3.-", "hy
 FLOOR_DEG = 1e-9  # a local/global run stops once this close (no curve below it is plotted)
 THRESHOLDS = (1.0, 0.1, 0.01)  # degrees
 PLOT_COLUMNS = 5
+#: --quick: these scenes, this local/global budget, one run
+QUICK_SCENES, QUICK_BUDGET = ("hinge_LpH5", "vertex_thin_actuated"), 300
 
 
 def hinge_scene(ratio: float):
@@ -127,7 +130,17 @@ def trace(scene, solver: str, budget: int, every: int = 1):
 
     tolerance = 1e-10 if solver in ("rigid", "hybrid") else 0.0
     result = sim.run(tolerance=tolerance, max_iterations=budget, callback=record)
-    return points, result, sim
+    return with_end(points, result, expected, creases), result, sim
+
+
+def with_end(points: list, result, expected, creases) -> list:
+    """``points`` ending with the run's result (its strategy seconds and error): the
+    rigid-body strategies step a coarse twin and move the mesh, which the callback
+    measures, only where they hand over or end."""
+    t = result.timings_s
+    end = (int(result.iterations), t["setup"] + t["projection"] + t["solve"],
+           float(np.abs(result.fold_angles_deg[creases] - expected).max()))
+    return points[:-1] + [end] if points and points[-1][0] == end[0] else points + [end]
 
 
 def first_below(points, threshold):
@@ -137,36 +150,47 @@ def first_below(points, threshold):
     return None
 
 
-def measure_scene(name, make, budget):
+def measure_scene(name, make, budget, runs: int) -> dict:
+    """Every strategy on one scene: the median-time run's curve and figures. Round 1
+    runs every strategy, later rounds the rigid-body ones (RUNS in all)."""
+    traces = {solver: [] for solver in SOLVERS}
+    for round_ in range(runs):
+        for solver in SOLVERS:
+            rigid_like = solver in ("rigid", "hybrid")
+            if round_ == 0 or rigid_like:
+                traces[solver].append(trace(make(), solver,
+                                            RIGID_BUDGET if solver == "rigid" else budget,
+                                            every=1 if rigid_like else 20))
     rows = {}
     for solver in SOLVERS:
-        rigid_like = solver in ("rigid", "hybrid")
-        runs = RUNS if rigid_like else 1
-        traces = [trace(make(), solver, RIGID_BUDGET if solver == "rigid" else budget,
-                        every=1 if rigid_like else 20)
-                  for _ in range(runs)]
-        totals = [tr[0][-1][1] for tr in traces]
-        points, result, sim = traces[int(np.argsort(totals)[len(totals) // 2])]
-        its = np.array([p[0] for p in points])
-        secs = np.array([p[1] for p in points])
-        per_it = float(np.median(np.diff(secs[its <= 100]) / np.diff(its[its <= 100]))) \
-            if len(its) > 2 else float("nan")
-        rows[solver] = {
-            "iterations": result.iterations, "converged": result.converged,
-            "final_error_deg": points[-1][2], "seconds": points[-1][1],
-            "seconds_runs": totals, "seconds_per_iteration": per_it,
-            "to_threshold": {f"{t:g}": first_below(points, t) for t in THRESHOLDS},
-            "curve": points}
-        rows[solver]["per_iteration_vs_bare_solve"] = per_it / result.timings_s["bare_solve"]
-        rows[solver]["rejected"] = getattr(getattr(sim.strategy, "lbfgs", sim.strategy),
-                                          "rejected", None)
+        totals = [tr[0][-1][1] for tr in traces[solver]]
+        points, result, _ = traces[solver][int(np.argsort(totals)[len(totals) // 2])]
+        rows[solver] = summary(points, result, totals)
         print(f"{name:22s} {solver:8s} its {result.iterations:6d} "
               f"err {points[-1][2]:.3g}° time {statistics.median(totals):.3f} s", flush=True)
     return rows
 
 
+def summary(points: list, result, totals: list) -> dict:
+    """A run's figures: iterations, final error, strategy seconds (and every run's),
+    seconds per iteration over the first 100, to each threshold, its curve."""
+    its = np.array([p[0] for p in points])
+    secs = np.array([p[1] for p in points])
+    first = its <= 100
+    per_it = (float(np.median(np.diff(secs[first]) / np.diff(its[first])))
+              if np.count_nonzero(first) > 2 else float("nan"))
+    bare = result.timings_s.get("bare_solve")  # only where the run factorised K
+    return {"iterations": result.iterations, "converged": result.converged,
+            "final_error_deg": points[-1][2], "seconds": points[-1][1],
+            "seconds_runs": totals, "seconds_per_iteration": per_it,
+            "per_iteration_vs_bare_solve": per_it / bare if bare else None,
+            "to_threshold": {f"{t:g}": first_below(points, t) for t in THRESHOLDS},
+            "curve": points}
+
+
 def reference(make):
-    """A rigid run converged to a 1e-13 step: the thick model's own answer, beside the closed form."""
+    """A rigid run converged to a 1e-13 step: the thick model's own answer, beside the
+    closed form."""
     pattern, mesh, expected, creases = make()
     sim = Simulation(mesh, pattern, solver="rigid")
     ref = sim.run(tolerance=1e-13, max_iterations=500)
@@ -175,14 +199,11 @@ def reference(make):
             "closed_form_deg": list(map(float, expected))}
 
 
-def plot(data, path: Path) -> None:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+def plot(document: dict, path) -> None:
+    plt = _meta.pyplot()
+    data = document["scenes"]
     names = list(data)
-    cols = PLOT_COLUMNS
+    cols = min(PLOT_COLUMNS, len(names))
     groups = -(-len(names) // cols)
     fig, axes = plt.subplots(2 * groups, cols, figsize=(3.2 * cols, 5.6 * groups),
                              squeeze=False)
@@ -203,47 +224,46 @@ def plot(data, path: Path) -> None:
         axes[2 * (j // cols), j % cols].axis("off")
         axes[2 * (j // cols) + 1, j % cols].axis("off")
     axes[0, 0].legend()
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    _meta.save(fig, path)
 
 
-def main() -> None:
-    trace(hinge_scene(5.0), "rigid", 5)  # warm-up: numba cache load, first factorisation
-    for solver in ("paper", "anderson", "lbfgs"):
-        trace(hinge_scene(5.0), solver, 5)
-    load, busy = [os.getloadavg()[0]], others_busy()
-    data = {}
-    for name, (make, budget) in SCENES.items():
-        data[name] = measure_scene(name, make, budget)
-        data[name]["budget_local_global"] = budget
-        if name.startswith("vertex"):
-            data[name]["reference"] = reference(make)
-    RESULTS.mkdir(exist_ok=True)
-    meta = {**machine_meta(), "runs_rigid": RUNS, "runs_local_global": 1,
-            "tolerance": {"rigid": 1e-10, "local_global": 0.0, "stop_below_deg": FLOOR_DEG},
-            "budget_rigid": RIGID_BUDGET, "others_busy_before": busy,
-            "load_average_1min": load + [os.getloadavg()[0]]}
-    (RESULTS / "convergence.json").write_text(json.dumps({"meta": meta, "scenes": data}))
-    plot(data, RESULTS / "convergence.png")
-
-
-def table(path: Path = RESULTS / "convergence.json") -> str:
-    """Markdown: per scene and strategy, iterations (strategy seconds) to 0.01°, or
-    'never' with the final error."""
-    scenes = json.loads(path.read_text())["scenes"]
+def table(document: dict) -> str:
+    """Per scene and strategy, iterations (strategy seconds) to 0.01°, or 'never' with
+    the final error."""
     body = []
-    for name, rows in scenes.items():
+    for name, rows in document["scenes"].items():
         cells = [name]
         for solver in SOLVERS:
             hit = rows[solver]["to_threshold"]["0.01"]
             cells.append(f"{hit['iterations']} ({hit['seconds']:.2g} s)" if hit else
                          f"never ({rows[solver]['final_error_deg']:.3g}°)")
         body.append(cells)
-    return markdown_table(["scene", *SOLVERS], body)
+    return _meta.markdown_table(["scene", *SOLVERS], body)
+
+
+def main() -> None:
+    args = _meta.parser(__doc__).parse_args()
+    if _meta.stored("convergence", args, table, plot):
+        return
+    for solver in ("rigid", "paper", "anderson", "lbfgs"):  # warm-up: numba cache, first factor
+        trace(hinge_scene(5.0), solver, 5)
+    runs = 1 if args.quick else RUNS
+    record = _meta.Record("convergence", args, runs_rigid=runs, runs_local_global=1,
+                          tolerance={"rigid": 1e-10, "local_global": 0.0,
+                                     "stop_below_deg": FLOOR_DEG},
+                          budget_rigid=RIGID_BUDGET, others_busy_before=_meta.others_busy())
+    data = {}
+    for name, (make, budget) in SCENES.items():
+        if args.quick and name not in QUICK_SCENES:
+            continue
+        budget = QUICK_BUDGET if args.quick else budget
+        data[name] = measure_scene(name, make, budget, runs)
+        data[name]["budget_local_global"] = budget
+        if name.startswith("vertex"):
+            data[name]["reference"] = reference(make)
+    record.write({"scenes": data}, plot, indent=None)
+    print(table({"scenes": data}))
 
 
 if __name__ == "__main__":
-    if "--table" in sys.argv[1:]:
-        print(table())
-    else:
-        main()
+    main()

@@ -1,17 +1,16 @@
-"""Steady under load (issue 17, item 4): a step's time with the cores shared.
+"""Steady under load: a step's time with the cores shared.
 
 Per case, the time of single strategy steps (``Simulation.step``; warm numba
 cache, STEPS timed after WARMUP), measured quiet and with COMPETITORS
 CPU-bound processes (``while True: pass``) sharing the machine's cores; the
 rounds alternate quiet / loaded ROUNDS times, so a change of the machine's
 own load hits both. Reported per case and condition: median, 95th and 99th
-percentile and largest step time, and their ratios to the quiet median. With every core taken by a
-competitor, a step that computes should cost about (competitors + 1) / cores
+percentile and largest step time, and their ratios to the quiet median. With
+every core taken by a competitor, a step that computes should cost about (competitors + 1) / cores
 of its quiet time; one that waits on spinning or yielding threads (numba's
-parallel loops, OpenBLAS's threads) can cost far more — the issue measured
-40–80 ms instead of 0.2 ms for a paper step of a Miura 4 × 4, and 26–182 ms
-instead of ≈ 1 ms for an L-BFGS step of a Miura 10 × 10 with ``threads=1``.
-Target: no case ≥ 10× its quiet median.
+parallel loops, OpenBLAS's threads) can cost far more (measured before the
+wait policy below was set: 40–80 ms instead of 0.2 ms for a paper step of a
+Miura 4 × 4). Target: no case ≥ 10× its quiet median.
 
 Cases: ``paper`` Miura 4 × 4 (serial by size), ``lbfgs`` Miura 10 × 10 with
 ``threads=1`` and with the default (2) threads, ``paper`` Miura 20 × 20
@@ -26,9 +25,12 @@ The whole measurement runs in child processes, alternating REPEATS times
 between OpenMP wait policies (POLICIES): ``PASSIVE``, which ``import
 foldcore`` sets unless the user set the variable, and GNU OpenMP's default
 (threads spin before they sleep), so the gain of the setting is measured in
-one run. Each policy's times are merged over its children. Run:
-``.venv/bin/python bench/load.py`` (~1.5 min). Writes bench/results/load.json
-and .png.
+one run. Each policy's times are merged over its children. Each child warms
+every simulation up (WARMUP iterations) before it times anything.
+
+Run: ``python bench/load.py`` (~1.5 min) or ``--quick``; writes
+bench/results/load.json and .png; ``--table`` prints the table of
+docs/benchmarks.md from the JSON.
 """
 from __future__ import annotations
 
@@ -36,17 +38,17 @@ import json
 import os
 import subprocess
 import sys
+import tempfile
 import time
 from functools import partial
 from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).parent))
-from _meta import machine_meta  # noqa: E402
+import _meta
 
-ROOT = Path(__file__).resolve().parents[1]
 WARMUP, STEPS, ROUNDS, REPEATS = 20, 150, 3, 2
+QUICK_STEPS, QUICK_ROUNDS, QUICK_REPEATS = 20, 1, 1
 # OpenMP wait policies compared, each in its own child processes (libgomp
 # reads the variable once, when it loads): foldcore's default, and GNU
 # OpenMP's own (threads spin ~300 000 polls before they sleep)
@@ -99,35 +101,35 @@ def competitors() -> list:
             for _ in range(COMPETITORS)]
 
 
-def measure() -> dict:
-    """Raw step and control times (s) per case and condition, ROUNDS alternating
-    quiet / loaded rounds in this process; and the load averages between them."""
+def measure(steps: int, rounds: int) -> dict:
+    """Raw step and control times (s) per case and condition, ``rounds`` alternating
+    quiet / loaded rounds of ``steps`` steps in this process; and the load averages
+    between them."""
     sims = {name: simulation(*case) for name, case in CASES.items()}
-    counts = {name: calibrated_count(float(np.median(run_times(sim.step, STEPS))))
+    counts = {name: calibrated_count(float(np.median(run_times(sim.step, steps))))
               for name, sim in sims.items()}
     controls = {f"control for {name}": count for name, count in counts.items()}
     times = {name: {"quiet": [], "loaded": []} for name in (*CASES, *controls)}
     load = [os.getloadavg()]
-    for _ in range(ROUNDS):
+    for _ in range(rounds):
         for condition in ("quiet", "loaded"):
             busy = competitors() if condition == "loaded" else []
             try:
                 time.sleep(0.5 if busy else 0.0)  # let the competitors take the cores
                 for name, sim in sims.items():
-                    times[name][condition] += run_times(sim.step, STEPS)
+                    times[name][condition] += run_times(sim.step, steps)
                     control = f"control for {name}"
                     work = partial(serial_work, controls[control])
-                    times[control][condition] += run_times(work, STEPS)
+                    times[control][condition] += run_times(work, steps)
             finally:
                 for p in busy:
                     p.kill()
                     p.wait()
             load.append(os.getloadavg())
-    return {"times": times, "load": load, "threads": {n: s.threads for n, s in sims.items()},
-            "loop_counts": controls}
+    return {"times": times, "load": load, "loop_counts": controls}
 
 
-def child(policy: str, out: Path) -> None:
+def child(policy: str, out: Path, steps: int, rounds: int) -> None:
     """One measurement with OpenMP's wait policy ``policy`` ("default": GNU
     OpenMP's own, i.e. unset after ``import foldcore`` set it and before
     anything loaded libgomp)."""
@@ -137,7 +139,7 @@ def child(policy: str, out: Path) -> None:
         os.environ.pop("OMP_WAIT_POLICY", None)
     else:
         os.environ["OMP_WAIT_POLICY"] = policy
-    out.write_text(json.dumps(measure()))
+    out.write_text(json.dumps(measure(steps, rounds)))
 
 
 def summary(t: dict) -> dict:
@@ -157,53 +159,71 @@ def summary(t: dict) -> dict:
             "steps": {"quiet": int(q.size), "loaded": int(b.size)}}
 
 
-def main() -> None:
-    """Alternate child processes over POLICIES REPEATS times; merge each policy's times."""
+def children(steps: int, rounds: int, repeats: int) -> tuple[dict, dict]:
+    """Alternate child processes over POLICIES ``repeats`` times; each policy's times
+    merged, and its load averages and loop counts."""
     merged = {policy: {} for policy in POLICIES}
-    meta = {policy: {"load": [], "threads": {}, "loop_counts": []} for policy in POLICIES}
-    scratch = ROOT / "bench" / "results" / ".load-child.json"
-    try:
-        for _ in range(REPEATS):
+    meta = {policy: {"load": [], "loop_counts": []} for policy in POLICIES}
+    with tempfile.TemporaryDirectory() as tmp:
+        scratch = Path(tmp) / "load-child.json"
+        for _ in range(repeats):
             for policy, value in POLICIES.items():
-                subprocess.run([sys.executable, __file__, "--child", value, str(scratch)],
-                               check=True)
+                subprocess.run([sys.executable, __file__, "--child", value, str(scratch),
+                                str(steps), str(rounds)], check=True)
                 run = json.loads(scratch.read_text())
                 for name, t in run["times"].items():
                     slot = merged[policy].setdefault(name, {"quiet": [], "loaded": []})
                     slot["quiet"] += t["quiet"]
                     slot["loaded"] += t["loaded"]
                 meta[policy]["load"] += run["load"]
-                meta[policy]["threads"] = run["threads"]
                 meta[policy]["loop_counts"].append(run["loop_counts"])
-    finally:
-        scratch.unlink(missing_ok=True)
-    out = {"policies": {}, "steps_per_round": STEPS, "rounds_per_child": ROUNDS,
-           "children_per_policy": REPEATS, "competitors": COMPETITORS,
-           "machine": machine_meta()}
+    return merged, meta
+
+
+def main() -> None:
+    args = _meta.parser(__doc__).parse_args()
+    if _meta.stored("load", args, table, lambda data, path: plot(data["policies"], path)):
+        return
+    steps, rounds, repeats = ((QUICK_STEPS, QUICK_ROUNDS, QUICK_REPEATS) if args.quick
+                              else (STEPS, ROUNDS, REPEATS))
+    record = _meta.Record("load", args, steps_per_round=steps, rounds_per_child=rounds,
+                          children_per_policy=repeats, competitors=COMPETITORS,
+                          warmup_iterations=WARMUP)
+    merged, meta = children(steps, rounds, repeats)
+    out = {"policies": {}}
     for policy, times in merged.items():
-        rows = {name: {"threads": meta[policy]["threads"].get(name, 1), **summary(t)}
-                for name, t in times.items()}
+        threads = {f"control for {n}": 1 for n in CASES}
+        threads.update({n: case[2] or "default" for n, case in CASES.items()})
+        rows = {name: {"threads": threads[name], **summary(t)} for name, t in times.items()}
         out["policies"][policy] = {"OMP_WAIT_POLICY": POLICIES[policy], "cases": rows,
                                    "load": meta[policy]["load"],
                                    "loop_counts": meta[policy]["loop_counts"]}
-        print(f"-- OpenMP wait policy: {policy}")
-        for name, r in rows.items():
-            print(f"{name:48s} threads {r['threads']}  quiet {r['quiet_median_ms']:.3f} ms"
-                  f" (p95 {r['quiet_p95_ms']:.3f})  loaded {r['loaded_median_ms']:.3f} ms"
-                  f" (p95 {r['loaded_p95_ms']:.3f})  ratio {r['median_ratio']:.2f}"
-                  f" / p95 {r['p95_ratio']:.2f} / p99 {r['p99_ratio']:.1f}"
-                  f" / max {r['max_ratio']:.0f}", flush=True)
-    results = ROOT / "bench" / "results"
-    (results / "load.json").write_text(json.dumps(out, indent=1))
-    plot(out["policies"], results / "load.png")
+    record.write(out, lambda data, path: plot(data["policies"], path))
+    print(table(out))
+
+
+def table(data: dict) -> str:
+    """Per wait policy and case: quiet median (ms), loaded / quiet at the median, 95th
+    and 99th percentile, and the serial control's 99th."""
+    rows = []
+    for policy, entry in data["policies"].items():
+        cases = entry["cases"]
+        for name, r in cases.items():
+            if name.startswith("control for "):
+                continue
+            control = cases[f"control for {name}"]
+            rows.append([policy, name, f"{r['quiet_median_ms']:.3g}",
+                         f"{r['median_ratio']:.2f}", f"{r['p95_ratio']:.1f}",
+                         f"{r['p99_ratio']:.1f}", f"{control['p99_ratio']:.1f}"])
+    return _meta.markdown_table(["OpenMP wait policy", "case", "quiet median (ms)",
+                                 "loaded / quiet: median", "95th pct", "99th pct",
+                                 "serial control, 99th"], rows)
 
 
 def plot(policies: dict, path: Path) -> None:
     """Per wait policy (one panel each) and case, loaded / quiet ratios of the step
     (solid) and of its serial control (hatched)."""
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = _meta.pyplot()
 
     stats = (("median_ratio", "median"), ("p95_ratio", "95th pct"),
              ("p99_ratio", "99th pct"), ("max_ratio", "max"))
@@ -229,12 +249,11 @@ def plot(policies: dict, path: Path) -> None:
     np.atleast_1d(axes)[0].legend(fontsize=7, ncol=2)
     fig.suptitle(f"step time with {COMPETITORS} CPU-bound competitors, beside a serial"
                  " loop of the same quiet length")
-    fig.tight_layout()
-    fig.savefig(path, dpi=100)
+    _meta.save(fig, path, dpi=100)
 
 
 if __name__ == "__main__":
     if sys.argv[1:2] == ["--child"]:
-        child(sys.argv[2], Path(sys.argv[3]))
+        child(sys.argv[2], Path(sys.argv[3]), int(sys.argv[4]), int(sys.argv[5]))
     else:
         main()

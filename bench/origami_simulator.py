@@ -1,8 +1,8 @@
-"""Origami Simulator beside foldcore on its own Miura, folded flat, in one run (issue 17).
+"""Origami Simulator beside foldcore on its own Miura, folded flat, in one run.
 
-Issue 17's first target: Origami Simulator's ``Tessellations/miura-ori.svg``
-folded flat (100 %) converged in ≤ 0.5 s, ≥ 10 × faster than Origami Simulator
-*in the same run*. This benchmark runs both, interleaved, ``ROUNDS`` rounds:
+The target: Origami Simulator's ``Tessellations/miura-ori.svg`` folded flat
+(100 %) converged in ≤ 0.5 s, ≥ 10 × faster than Origami Simulator *in the
+same run*. This benchmark runs both, interleaved, ``ROUNDS`` rounds:
 
 * **Origami Simulator** (Amanda Ghassaei, MIT licence; not part of this
   project: read from a snapshot of github.com/amandaghassaei/OrigamiSimulator,
@@ -24,31 +24,35 @@ folded flat (100 %) converged in ≤ 0.5 s, ≥ 10 × faster than Origami Simula
   each threshold the node positions are taken, and the fold angle of every
   M/V crease is measured from them (Python side: the angle between the two
   triangles' normals) against its target (±180°).
-* **foldcore**: the same layout as ``bench/os_miura.py``'s
-  "arc, graded W, H = 0.01a" row (Miura 12 × 13, a = 80 mm, γ = 84°, arc
-  hinges with graded widths, every crease driven to its closed form,
-  default strategy, tolerance 1e-9), warm numba cache, one warm-up fold in
-  this process first; ``seconds`` is ``Simulation(...).run()`` (the mesh
-  is built once, outside the timing, as for Origami Simulator's page load).
+* **foldcore**: the same layout (Miura 12 × 13, a = b = 80 mm, γ = 84°;
+  H = 0.01a, arc hinges of Eq. 7's width W = πH/2 graded along each straight
+  line by ``patterns.miura_flat_widths`` — the widths that let a thick Miura
+  fold flat: docs/design.md#a-thick-miura-has-no-flat-state-with-equal-hinges
+  — every crease driven to its rigid-fold angle at facet tilt 90°, default
+  strategy, tolerance 1e-9), warm numba cache, one warm-up fold in this
+  process first; ``seconds`` is ``Simulation(...).run()`` (the mesh is built
+  once, outside the timing, as for Origami Simulator's page load). Its
+  misses: the largest on the straight and on the zig-zag creases (degrees).
 
 Reported per round: both times, their ratio (Origami Simulator / foldcore),
 Origami Simulator's steps, strain and angle error at each threshold, and
 foldcore's iterations and misses; ``others_busy`` before each run (share of
 the cores other processes used). Writes bench/results/origami_simulator.json
 and .png (Origami Simulator's mean strain against time, foldcore's fold time
-marked). Run: ``.venv/bin/python bench/origami_simulator.py
-[--origami-simulator PATH]`` (~2 min; needs /usr/bin/chromium, which
-``make test`` installs).
+marked).
+
+Run: ``python bench/origami_simulator.py [--origami-simulator PATH]`` (~2 min;
+needs /usr/bin/chromium, which ``make test`` installs; skipped when either is
+missing) or ``--quick`` (one round, the first threshold); ``--table`` prints
+the table of docs/benchmarks.md from the JSON.
 """
 from __future__ import annotations
 
-import argparse
 import http.server
 import json
 import queue
 import shutil
 import subprocess
-import sys
 import tempfile
 import threading
 import time
@@ -56,10 +60,7 @@ from pathlib import Path
 
 import numpy as np
 
-HERE = Path(__file__).resolve().parent
-RESULTS = HERE / "results"
-sys.path.insert(0, str(HERE))
-from _meta import machine_meta, markdown_table  # noqa: E402
+import _meta
 
 DEFAULT_SOURCE = Path("/work/.mirror/amandaghassaei+OrigamiSimulator/repo")
 MODEL = "Tessellations/miura-ori.svg"
@@ -70,10 +71,13 @@ FLAGS = ["--headless", "--no-sandbox", "--disable-gpu", "--enable-unsafe-swiftsh
          "--disable-background-timer-throttling", "--disable-renderer-backgrounding",
          "--window-size=1280,800"]
 ROUNDS = 3
-STRAINS = (0.01, 0.001)  # mean node strain thresholds, percent (the issue's)
+STRAINS = (0.01, 0.001)  # mean node strain thresholds, percent
 OS_LIMIT_S = 60.0        # Origami Simulator gives up after this long
+QUICK = {"rounds": 1, "strains": STRAINS[:1], "limit_s": 30.0}
 PAGE_TIMEOUT_S = 180.0
 FOLDCORE_CASE = "arc, graded W, H = 0.01a"
+N, M, A, GAMMA, H_OVER_A = 12, 13, 80.0, 84.0, 0.01  # facets, mm, degrees
+TOLERANCE, BUDGET = 1e-9, 5_000
 HARNESS_PAGE = "foldcore_harness.html"
 #: what the page needs (a snapshot may lack its largest files, e.g. other demos)
 PAGE_FILES = ("index.html", "favicon.ico", "js", "css", "dependencies", "fonts",
@@ -147,15 +151,15 @@ def extract(source: Path, into: Path) -> str:
     return commit
 
 
-def harness_page(root: Path) -> None:
+def harness_page(root: Path, strains, limit_s: float) -> None:
     """``HARNESS_PAGE`` in ``root``: index.html without the script it loads from
     Google (its inline ``gtag`` stub, which the app calls, stays: it only queues),
-    the harness script after main.js."""
+    the harness script (thresholds ``strains``, %, and ``limit_s``) after main.js."""
     html = (root / "index.html").read_text()
     start = html.index('<script async src="https://www.googletagmanager.com')
     end = html.index("</script>", start) + len("</script>")
     html = html[:start] + html[end:]
-    script = HARNESS_JS % {"strains": json.dumps(list(STRAINS)), "limit": OS_LIMIT_S}
+    script = HARNESS_JS % {"strains": json.dumps(list(strains)), "limit": limit_s}
     anchor = '<script type="text/javascript" src="js/main.js"></script>'
     if anchor not in html:
         raise SystemExit("origami_simulator: index.html has no main.js script tag "
@@ -234,21 +238,66 @@ def run_origami_simulator(root: Path, profile: Path) -> dict:
 
 
 def foldcore_case():
-    """(pattern, mesh, kinds, options) of os_miura's graded flat row."""
-    import os_miura
+    """(pattern, mesh, edge kinds) of the Miura with graded arc hinges, driven flat."""
+    from foldcore import patterns, thicken
 
-    (_, h, w, tilt, options), = [c for c in os_miura.CASES if c[0] == FOLDCORE_CASE]
-    pattern, mesh, kinds = os_miura.build(h, w, tilt, options)
-    return pattern, mesh, kinds, options
+    thickness = H_OVER_A * A
+    widths = patterns.miura_flat_widths(N, M, np.pi / 2 * thickness)
+    pattern = patterns.miura(N, M, a=A, b=A, gamma=GAMMA).replace(
+        widths=widths, fold_angles=patterns.miura_fold_angles(N, M, GAMMA, 90.0))
+    return pattern, thicken(pattern, thickness, hinge="arc"), patterns.miura_edge_kinds(N, M)
+
+
+def fold_once(pattern, mesh, kinds) -> dict:
+    """One default fold of the case: seconds, iterations, verdict, misses (degrees)."""
+    from foldcore import Simulation
+
+    start = time.perf_counter()
+    result = Simulation(mesh, pattern).run(tolerance=TOLERANCE, max_iterations=BUDGET)
+    seconds = time.perf_counter() - start
+    miss = np.abs(result.fold_angles_deg - pattern.fold_angles)
+    return {"seconds": seconds, "iterations": result.iterations,
+            "converged": result.converged, "reason": result.reason,
+            "energy": float(result.energy[-1]) if len(result.energy) else 0.0,
+            "straight_miss_deg": float(np.nanmax(miss[kinds == "straight"])),
+            "zigzag_miss_deg": float(np.nanmax(miss[kinds == "zigzag"])),
+            "thick_vertices": mesh.n_vertices}
+
+
+def rounds_of(source: Path, q: dict, tmp: Path, case) -> tuple[str, list]:
+    """Origami Simulator's commit and ``q["rounds"]`` interleaved rounds of both."""
+    root = tmp / "OrigamiSimulator"
+    root.mkdir()
+    commit = extract(source, root)
+    harness_page(root, q["strains"], q["limit_s"])
+    rounds = []
+    for k in range(q["rounds"]):
+        busy_os = _meta.others_busy(1.0)
+        simulator = run_origami_simulator(root, tmp / f"profile{k}")
+        busy_fc = _meta.others_busy(1.0)
+        ours = fold_once(*case)
+        first = simulator["reached"][0]["seconds"] if simulator["reached"] else None
+        rounds.append({"origami_simulator": simulator, "foldcore": ours,
+                       "others_busy": {"origami_simulator": busy_os, "foldcore": busy_fc},
+                       "ratio_first_strain": first / ours["seconds"] if first else None})
+        reached = ", ".join(f"< {h['strain_below']:g} %: {h['seconds']:.2f} s "
+                            f"({h['steps']} steps, max angle error "
+                            f"{h['max_angle_error_deg']:.3g}°)" for h in simulator["reached"])
+        print(f"round {k}: Origami Simulator {reached or 'no threshold reached'}; "
+              f"foldcore {ours['seconds']:.3f} s, {ours['iterations']} iterations, "
+              f"straight miss {ours['straight_miss_deg']:.2g}° (busy {busy_os:.2f}, "
+              f"{busy_fc:.2f})", flush=True)
+    return commit, rounds
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--origami-simulator", type=Path, default=None,
-                        help="Origami Simulator: a bare git dir or a checkout "
-                             f"(default {DEFAULT_SOURCE}; skipped when absent)")
-    parser.add_argument("--rounds", type=int, default=ROUNDS)
-    args = parser.parse_args()
+    p = _meta.parser(__doc__)
+    p.add_argument("--origami-simulator", type=Path, default=None,
+                   help="Origami Simulator: a bare git dir or a checkout "
+                        f"(default {DEFAULT_SOURCE}; skipped when absent)")
+    args = p.parse_args()
+    if _meta.stored("origami_simulator", args, table, plot):
+        return
     source = args.origami_simulator or DEFAULT_SOURCE
     missing = [f"{p} not found" for p in (source, Path(CHROMIUM)) if not p.exists()]
     if missing and args.origami_simulator is None:  # e.g. under bench/run.py: not an error
@@ -257,45 +306,18 @@ def main() -> None:
               "github.com/amandaghassaei/OrigamiSimulator; make test installs Chromium)")
         return
     if missing:
-        sys.exit(f"origami_simulator: {'; '.join(missing)}")
-    import os_miura
-    from scaling import others_busy
-
-    pattern, mesh, kinds, options = foldcore_case()
-    os_miura.fold_once(pattern, mesh, kinds, options)  # warm-up
-    rounds = []
+        raise SystemExit(f"origami_simulator: {'; '.join(missing)}")
+    q = QUICK if args.quick else {"rounds": ROUNDS, "strains": STRAINS, "limit_s": OS_LIMIT_S}
+    case = foldcore_case()
+    fold_once(*case)  # warm-up
+    record = _meta.Record("origami_simulator", args, model=MODEL,
+                          strains_percent=list(q["strains"]), foldcore_case=FOLDCORE_CASE,
+                          rounds=q["rounds"], chromium_flags=FLAGS)
     with tempfile.TemporaryDirectory() as tmp:
-        root = Path(tmp) / "OrigamiSimulator"
-        root.mkdir()
-        commit = extract(source, root)
-        harness_page(root)
-        for k in range(args.rounds):
-            busy_os = others_busy(1.0)
-            simulator = run_origami_simulator(root, Path(tmp) / f"profile{k}")
-            busy_fc = others_busy(1.0)
-            ours = os_miura.fold_once(pattern, mesh, kinds, options)
-            first = simulator["reached"][0]["seconds"] if simulator["reached"] else None
-            rounds.append({"origami_simulator": simulator, "foldcore": ours,
-                           "others_busy": {"origami_simulator": busy_os, "foldcore": busy_fc},
-                           "ratio_first_strain": first / ours["seconds"] if first else None})
-            reached = ", ".join(f"< {h['strain_below']:g} %: {h['seconds']:.2f} s "
-                                f"({h['steps']} steps, max angle error "
-                                f"{h['max_angle_error_deg']:.3g}°)"
-                                for h in simulator["reached"])
-            print(f"round {k}: Origami Simulator {reached or 'no threshold reached'}; "
-                  f"foldcore {ours['seconds']:.3f} s, {ours['iterations']} iterations, "
-                  f"straight miss {ours['straight_miss_deg']:.2g}° (busy {busy_os:.2f}, "
-                  f"{busy_fc:.2f})", flush=True)
-    out = {"meta": {**machine_meta(), "date": time.strftime("%Y-%m-%d"),
-                    "origami_simulator_commit": commit, "model": MODEL, "strains_percent":
-                    list(STRAINS), "foldcore_case": FOLDCORE_CASE, "rounds": args.rounds,
-                    "chromium_flags": FLAGS},
-           "rounds": rounds}
-    RESULTS.mkdir(exist_ok=True)
-    path = RESULTS / "origami_simulator.json"
-    path.write_text(json.dumps(out, indent=1))
-    plot(out, path.with_suffix(".png"))
-    print(table(out))
+        commit, rounds = rounds_of(source, q, Path(tmp), case)
+    record.meta["origami_simulator_commit"] = commit
+    record.write({"rounds": rounds}, plot)
+    print(table({"meta": record.meta, "rounds": rounds}))
 
 
 def summary(out: dict) -> dict:
@@ -330,16 +352,12 @@ def table(out: dict) -> str:
                  f"{s['foldcore_seconds']:.2f}",
                  " / ".join(map(str, s["foldcore_iterations"])) + " iterations",
                  f"{s['foldcore_straight_miss_deg']:.2g}", "1"])
-    return markdown_table(["run", "s (median)", "work", "max crease miss (°)",
+    return _meta.markdown_table(["run", "s (median)", "work", "max crease miss (°)",
                            "× foldcore's time, per round"], rows)
 
 
 def plot(out: dict, path: Path) -> None:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+    plt = _meta.pyplot()
     fig, ax = plt.subplots(figsize=(7, 4.2))
     for k, r in enumerate(out["rounds"]):
         log = np.array(r["origami_simulator"]["log"])
@@ -349,16 +367,12 @@ def plot(out: dict, path: Path) -> None:
                    label="foldcore: converged fold (tolerance 1e-9)" if k == 0 else None)
     for level in out["meta"]["strains_percent"]:
         ax.axhline(level, color="0.6", ls=":", lw=1)
-    ax.set_xlabel("seconds (this host, one run per round, interleaved)")
+    ax.set_xlabel("seconds (one run per round, interleaved)")
     ax.set_ylabel("mean strain, %")
     ax.set_title("Origami Simulator's miura-ori.svg folded flat", fontsize=9)
     ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
+    _meta.save(fig, path, dpi=120)
 
 
 if __name__ == "__main__":
-    if len(sys.argv) > 1 and sys.argv[1] == "--table":
-        print(table(json.loads((RESULTS / "origami_simulator.json").read_text())))
-    else:
-        main()
+    main()

@@ -1,67 +1,78 @@
-"""Reading at scale (issue 18 item 5): read time and peak memory of large inputs.
+"""Reading at scale: read time and peak memory of large inputs; and a folder of SVGs.
 
 Inputs (``tests/grids.py``): triangulated n × n-vertex grids, unit lattice in
 mm, interior creases cycling M/V/F, border B, ``faces_vertices`` given, as
 FOLD files (V = n² for n in SIZES: 10³…10⁶ vertices) in three cases —
 ``valid``; ``cross``: one more edge at the end crossing the last square's
 diagonal; ``twin_vertex``: one more vertex on top of vertex 0 with two edges
-overlapping its edges — and the valid grid as OBJ + hinge file
-(``write_obj``/``write_hinges``), read with ``read_mesh``.
+overlapping its edges — and the valid grid as OBJ + hinge file (written
+with ``foldcore.io.write_obj`` / ``write_hinges``). Every input is read with
+:func:`foldcore.read`.
 
 Each run is a fresh interpreter, so ``rss_mb``, its peak resident memory
 (``VmHWM`` of /proc/self/status, MiB: the JSON objects, NumPy arrays and
-GEOS geometries alike; ``ru_maxrss`` would keep the parent's across exec),
-is that read's alone; ``rss_baseline_mb`` is the peak
-after ``import foldcore.io`` and before the read. ``seconds`` is the wall time of
-``read_fold`` / ``read_mesh`` inside the child (file read included,
+GEOS geometries alike), is that read's alone; ``rss_baseline_mb`` is the peak
+after ``import foldcore`` and its readers, before the read. ``seconds`` is
+the wall time of ``foldcore.read`` inside the child (file read included,
 interpreter start and imports not). Per size and case: one warm-up run
 (discarded: page cache, .pyc), then RUNS runs; the median is reported.
 
 ``--before SRC`` also times another source tree (e.g. the main checkout's
-``src``, the code before this change), interleaved run by run with this
-one so load changes hit both: RUNS runs while its reads are fast, then
-one without warm-up once a size took more than 10 s; at 10⁶ vertices only
-the valid and crossing FOLD grids (the old reads take minutes each; see
-``reference_plan``). The machine is shared:
-``others_busy`` is the share of all cores other processes used during the
-run (from /proc/stat, this child's CPU time subtracted).
+``src``, the code before a change), interleaved run by run with this one so
+load changes hit both: RUNS runs while its reads are fast, one without
+warm-up once a size took more than SLOW_S / 6, and at 10⁶ vertices only on
+the valid and crossing FOLD grids unless ``--cases`` names the inputs
+(e.g. ``--sizes 1000 --cases valid twin_vertex``). ``others_busy`` is the
+share of all cores other processes used during each run.
 
-Run: ``.venv/bin/python bench/reading.py [--before ../main/src]``
-(~25 min with --before). Writes bench/results/reading.json and .png;
-``--plot`` redraws the PNG from the JSON; ``--inputs DIR`` keeps the
-generated files there (and reuses them: generating takes minutes).
+``--svgs DIR`` reads instead every SVG under DIR (or the ``assets/`` of a
+bare git directory, e.g. Origami Simulator's) in this process, after one
+warm-up read, and sorts each into read (vertices, edges, seconds) or
+refused, grouped by the kind of its one-line message, or crashed (any other
+exception: the reader's bug); writes bench/results/reading_svgs.json.
+
+Run: ``python bench/reading.py [--before ../main/src]`` (~25 min with
+--before) or ``--quick``; writes bench/results/reading.json and .png;
+``--inputs DIR`` keeps the generated files there (and reuses them:
+generating takes minutes); ``--table`` prints the table of
+docs/benchmarks.md from the JSON.
 """
 from __future__ import annotations
 
-import argparse
+import collections
 import json
 import os
 import resource
-import statistics
 import subprocess
 import sys
 import tempfile
 import time
+import warnings
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parent.parent
-RESULTS = Path(__file__).parent / "results"
+import _meta
+
 SIZES = (32, 100, 317, 1000)
+QUICK_SIZES, QUICK_RUNS = (10, 32), 2
 FOLD_CASES = ("valid", "cross", "twin_vertex")
 RUNS = 3
 #: A reference ("before") read slower than SLOW_S / 6 at one size runs once at the next.
 SLOW_S = 60.0
-#: At this many vertices and more the reference runs only on these inputs.
+#: At this many vertices and more the reference runs only on BEFORE_BIG (unless --cases).
 BEFORE_ONLY_ABOVE = 10**6
 BEFORE_BIG = {("fold", "valid"), ("fold", "cross")}
 CHILD_TIMEOUT_S = 1800
+#: kinds of SVG refusal, by a phrase of the message
+KINDS = (("curved", "curved"), ("cut", "is a cut"), ("overlap", "overlap with different"),
+         ("not connected", "not connected"), ("boundary/faces", "boundary"),
+         ("boundary/faces", "both sides"), ("dangling", "dangling"),
+         ("not an SVG", "not a readable SVG"))
 
 PROBE = """
 import json, sys, time, warnings
 warnings.simplefilter("ignore")
 import foldcore
-import foldcore.io as fio
-from foldcore.errors import PatternError
+read = foldcore.read  # imports the readers
 
 
 def peak_mb():  # this process image's own high-water mark (ru_maxrss keeps the parent's)
@@ -69,13 +80,13 @@ def peak_mb():  # this process image's own high-water mark (ru_maxrss keeps the 
         return next(int(l.split()[1]) for l in fh if l.startswith("VmHWM")) / 1024
 
 
-kind, path = sys.argv[1], sys.argv[2]
+path = sys.argv[1]
 rss0 = peak_mb()
 t = time.perf_counter()
 try:
-    p = fio.read_fold(path) if kind == "fold" else fio.read_mesh(path)
+    p = read(path)
     outcome = f"read: {p.n_vertices} vertices, {p.n_edges} edges, {len(p.faces)} faces"
-except PatternError as exc:
+except foldcore.PatternError as exc:
     outcome = "refused: " + str(exc).split(": ", 1)[1]
 seconds = time.perf_counter() - t
 print(json.dumps({"seconds": seconds, "outcome": outcome, "rss_baseline_mb": rss0,
@@ -83,28 +94,30 @@ print(json.dumps({"seconds": seconds, "outcome": outcome, "rss_baseline_mb": rss
 """
 
 
-def write_inputs(folder: Path, sizes) -> list[dict]:
+def write_inputs(folder: Path, sizes, cases) -> list[dict]:
     """Every input file; rows of (format, case, n, vertices, path, bytes)."""
-    sys.path.insert(0, str(ROOT / "tests"))
+    sys.path.insert(0, str(_meta.ROOT / "tests"))
     from grids import grid_fold
 
+    import foldcore
     from foldcore.io import write_hinges, write_obj
-    from foldcore.io.fold import pattern_from_fold_dict
 
     inputs = []
     for n in sizes:
         for case in FOLD_CASES:
             path = folder / f"grid{n}_{case}.fold"
-            if not path.exists():
+            if not path.exists() and (case in cases or case == "valid" and "obj" in cases):
                 path.write_text(json.dumps(grid_fold(n, flaw=None if case == "valid" else case)))
-            inputs.append({"format": "fold", "case": case, "n": n, "path": str(path)})
+            if case in cases:
+                inputs.append({"format": "fold", "case": case, "n": n, "path": str(path)})
         path = folder / f"grid{n}.obj"
-        if not path.with_suffix(".hinges").exists():
-            pattern = pattern_from_fold_dict(grid_fold(n), "grid")
-            write_obj(path, pattern)
-            write_hinges(path.with_suffix(".hinges"), pattern)
-            del pattern
-        inputs.append({"format": "obj", "case": "valid", "n": n, "path": str(path)})
+        if "obj" in cases:
+            if not path.with_suffix(".hinges").exists():
+                pattern = foldcore.read(folder / f"grid{n}_valid.fold")
+                write_obj(path, pattern)
+                write_hinges(path.with_suffix(".hinges"), pattern)
+                del pattern
+            inputs.append({"format": "obj", "case": "valid", "n": n, "path": str(path)})
     for row in inputs:
         row["vertices"] = row["n"] ** 2
         row["bytes"] = os.path.getsize(row["path"])
@@ -113,66 +126,137 @@ def write_inputs(folder: Path, sizes) -> list[dict]:
     return inputs
 
 
-def run_child(src: Path, kind: str, path: str) -> dict:
-    sys.path.insert(0, str(Path(__file__).parent))
-    from scaling import busy_seconds
-
+def run_child(src: Path, path: str) -> dict:
+    """One read of ``path`` by the tree ``src`` in a fresh interpreter, with the load."""
     env = dict(os.environ, PYTHONPATH=str(src))
-    start, busy0 = time.perf_counter(), busy_seconds()
+    start, busy0 = time.perf_counter(), _meta.busy_seconds()
     cpu0 = resource.getrusage(resource.RUSAGE_CHILDREN)
-    proc = subprocess.run([sys.executable, "-c", PROBE, kind, path], capture_output=True,
+    proc = subprocess.run([sys.executable, "-c", PROBE, path], capture_output=True,
                           text=True, env=env, timeout=CHILD_TIMEOUT_S, check=True)
     wall = time.perf_counter() - start
     cpu1 = resource.getrusage(resource.RUSAGE_CHILDREN)
     own = cpu1.ru_utime + cpu1.ru_stime - cpu0.ru_utime - cpu0.ru_stime
     row = json.loads(proc.stdout.strip().splitlines()[-1])
     assert row["file"].startswith(str(src)), (row["file"], src)
-    row["others_busy"] = max(0.0, (busy_seconds() - busy0 - own) / (wall * os.cpu_count()))
+    row["others_busy"] = max(0.0, (_meta.busy_seconds() - busy0 - own) / (wall * os.cpu_count()))
     return row
 
 
 def summary(runs: list[dict]) -> dict:
-    return {"seconds": statistics.median(r["seconds"] for r in runs),
-            "rss_mb": statistics.median(r["rss_mb"] for r in runs),
-            "rss_baseline_mb": statistics.median(r["rss_baseline_mb"] for r in runs),
-            "others_busy": statistics.median(r["others_busy"] for r in runs),
+    return {"seconds": _meta.median(r["seconds"] for r in runs),
+            "rss_mb": _meta.median(r["rss_mb"] for r in runs),
+            "rss_baseline_mb": _meta.median(r["rss_baseline_mb"] for r in runs),
+            "others_busy": _meta.median(r["others_busy"] for r in runs),
             "outcome": runs[0]["outcome"], "runs": len(runs),
             "seconds_runs": [r["seconds"] for r in runs],
             "rss_mb_runs": [r["rss_mb"] for r in runs]}
 
 
-def measure(row: dict, trees: dict, once: set) -> dict:
-    """Warm-up + RUNS interleaved runs of each source tree on one input; the trees
+def measure(row: dict, trees: dict, once: set, runs: int) -> dict:
+    """Warm-up + ``runs`` interleaved runs of each source tree on one input; the trees
     named in ``once`` run once, without warm-up."""
-    runs = {name: [] for name in trees}
+    done = {name: [] for name in trees}
     for name, src in trees.items():
         if name not in once:
-            run_child(src, row["format"], row["path"])  # warm-up, discarded
-    for i in range(RUNS):
+            run_child(src, row["path"])  # warm-up, discarded
+    for i in range(runs):
         for name, src in trees.items():
             if not (i and name in once):
-                runs[name].append(run_child(src, row["format"], row["path"]))
-    return {name: summary(r) for name, r in runs.items()}
+                done[name].append(run_child(src, row["path"]))
+    return {name: summary(r) for name, r in done.items()}
 
 
-def reference_plan(row: dict, trees: dict, previous: dict | None) -> tuple[dict, set]:
-    """The trees to run on ``row`` and those to run once: the reference tree once
-    after its previous size took more than SLOW_S / 6, and at 10⁶ vertices only
-    on the valid and crossing FOLD grids (its reads take minutes there)."""
+def reference_plan(row: dict, trees: dict, previous: dict | None,
+                   chosen: bool) -> tuple[dict, set]:
+    """The trees to run on ``row`` and those to run once: the reference tree once after
+    its previous size took more than SLOW_S / 6, and at 10⁶ vertices only on the valid
+    and crossing FOLD grids (its reads take minutes there) unless the cases were
+    ``chosen`` on the command line."""
     if "before" not in trees:
         return trees, set()
-    if row["vertices"] >= BEFORE_ONLY_ABOVE and (row["format"], row["case"]) not in BEFORE_BIG:
+    if (not chosen and row["vertices"] >= BEFORE_ONLY_ABOVE
+            and (row["format"], row["case"]) not in BEFORE_BIG):
         return {"after": trees["after"]}, set()
     slow = previous is not None and previous.get("before", {}).get("seconds", 0) > SLOW_S / 6
     return trees, {"before"} if slow else set()
 
 
-def plot(rows: list[dict], path: Path) -> None:
-    import matplotlib
+def grids(args, trees: dict) -> list:
+    """Every grid input measured (module docstring)."""
+    sizes = args.sizes or (QUICK_SIZES if args.quick else SIZES)
+    cases = args.cases or (*FOLD_CASES, "obj")
+    rows, previous = [], {}
+    with tempfile.TemporaryDirectory(prefix="foldcore-reading-") as tmp:
+        folder = args.inputs or Path(tmp)
+        folder.mkdir(parents=True, exist_ok=True)
+        for row in write_inputs(folder, sizes, cases):
+            key = (row["format"], row["case"])
+            plan = reference_plan(row, trees, previous.get(key), bool(args.cases))
+            result = measure(row, *plan, QUICK_RUNS if args.quick else RUNS)
+            previous[key] = result
+            rows.append({k: v for k, v in row.items() if k != "path"} | result)
+            if "before" in result:
+                rows[-1]["same_outcome"] = result["before"]["outcome"] == \
+                    result["after"]["outcome"]
+            print(f"{row['format']} {row['case']:11s} V={row['vertices']:>8d}: " + ", ".join(
+                f"{name} {r['seconds']:.2f} s {r['rss_mb']:.0f} MB (busy {r['others_busy']:.2f})"
+                for name, r in result.items()) + f" — {result['after']['outcome']}", flush=True)
+    return rows
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
 
+def svg_files(source: Path, into: Path) -> list[Path]:
+    """The SVGs under ``source``, a folder or a bare git directory (its ``assets/``
+    extracted into ``into``)."""
+    if (source / "HEAD").exists() and (source / "objects").is_dir():
+        git = ["git", "--git-dir", str(source)]
+        names = subprocess.run([*git, "ls-tree", "-r", "--name-only", "HEAD", "assets"],
+                               capture_output=True, text=True, check=True).stdout.split("\n")
+        archive = subprocess.run([*git, "archive", "HEAD", *[n for n in names
+                                                             if n.endswith(".svg")]],
+                                 capture_output=True, check=True).stdout
+        subprocess.run(["tar", "-x", "-C", str(into)], input=archive, check=True)
+        source = into
+    return sorted(source.rglob("*.svg"))
+
+
+def read_svg(path: Path) -> dict:
+    """One SVG read in this process: read, refused (by kind) or crashed; seconds."""
+    import foldcore
+
+    start = time.perf_counter()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        try:
+            p = foldcore.read(path)
+            entry = {"read": True, "vertices": int(p.n_vertices), "edges": int(p.n_edges)}
+        except foldcore.FoldcoreError as exc:
+            message = str(exc).split(": ", 1)[-1]
+            entry = {"read": False, "kind": next((k for k, needle in KINDS
+                                                  if needle in message), "other"),
+                     "message": message}
+        except Exception as exc:  # noqa: BLE001  (a crash is the reader's bug: counted)
+            entry = {"read": False, "kind": "crash", "message": repr(exc)}
+    return {**entry, "seconds": time.perf_counter() - start}
+
+
+def svgs(args) -> None:
+    """``--svgs``: every SVG of a folder through the reader (module docstring)."""
+    record = _meta.Record("reading_svgs", args, source=str(args.svgs))
+    with tempfile.TemporaryDirectory() as tmp:
+        files = svg_files(args.svgs, Path(tmp))
+        if files:
+            read_svg(files[0])  # warm-up: imports, shapely
+        each = [{"file": str(p.relative_to(p.parents[1])).replace("/", "__"), **read_svg(p)}
+                for p in files]
+    counts = collections.Counter("read" if e["read"] else "refused: " + e["kind"]
+                                 for e in each)
+    record.write({"files": len(each), "counts": dict(counts), "each": each})
+    print(json.dumps(dict(counts), indent=1))
+
+
+def plot(data: dict, path: Path) -> None:
+    plt = _meta.pyplot()
+    rows = data["rows"]
     fig, (ax_t, ax_m) = plt.subplots(1, 2, figsize=(11, 4.2))
     styles = {"valid": "o-", "cross": "s--", "twin_vertex": "^:"}
     for fmt in ("fold", "obj"):
@@ -192,54 +276,66 @@ def plot(rows: list[dict], path: Path) -> None:
         ax.set_xlabel("vertices")
         ax.set_ylabel(what)
         ax.grid(True, which="both", alpha=0.3)
-    ax_t.axhline(2, color="grey", lw=0.8)
-    ax_t.axhline(20, color="grey", lw=0.8)
     ax_m.legend(fontsize=7)
     fig.suptitle("Reading triangulated grids (bench/reading.py)")
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    _meta.save(fig, path)
+
+
+def table(data: dict) -> str:
+    """Per input: vertices, read seconds and peak RSS (and the reference tree's), outcome."""
+    before = any("before" in r for r in data["rows"])
+    rows = []
+    for r in data["rows"]:
+        a = r["after"]
+        cells = [f"{r['format'].upper()} {r['case'].replace('_', ' ')}", f"{r['vertices']:,}",
+                 _meta.sig(a["seconds"]), f"{a['rss_mb']:.0f}"]
+        if before:
+            b = r.get("before")
+            cells += ["—", "—"] if b is None else [
+                _meta.sig(b["seconds"]) + (" (1 run)" if b["runs"] == 1 else ""),
+                f"{b['rss_mb']:.0f}"]
+        rows.append(cells + [a["outcome"].split(":")[0]])
+    header = ["input", "vertices", "read (s)", "peak RSS (MB)"]
+    header += ["before: read (s)", "before: peak RSS (MB)"] if before else []
+    return _meta.markdown_table(header + ["outcome"], rows)
+
+
+def svgs_table(data: dict) -> str:
+    """Files read, refused by kind, and crashed, of ``--svgs``."""
+    counts = dict(data["counts"])
+    crashed = counts.pop("refused: crash", 0)
+    rows = sorted(counts.items(), key=lambda kv: (kv[0] != "read", -kv[1]))
+    return _meta.markdown_table(["outcome", "files"],
+                                [[k, str(v)] for k, v in rows + [("crashed", crashed)]])
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser = _meta.parser(__doc__)
     parser.add_argument("--before", type=Path, help="another source tree to time alongside")
-    parser.add_argument("--plot", action="store_true", help="redraw reading.png from the JSON")
     parser.add_argument("--inputs", type=Path, help="keep (and reuse) the input files here")
-    parser.add_argument("--sizes", type=int, nargs="+", default=SIZES,
-                        help="grid sides n (V = n²); default %(default)s")
+    parser.add_argument("--sizes", type=int, nargs="+", help="grid sides n (V = n²)")
+    parser.add_argument("--cases", nargs="+", choices=(*FOLD_CASES, "obj"),
+                        help="only these inputs (obj: the valid grid as OBJ + hinges)")
+    parser.add_argument("--svgs", type=Path, help="read every SVG of this folder instead")
     args = parser.parse_args()
-    if args.plot:
-        plot(json.loads((RESULTS / "reading.json").read_text())["rows"], RESULTS / "reading.png")
+    if args.svgs is not None:
+        svgs(args)
         return
-    sys.path.insert(0, str(Path(__file__).parent))
-    from _meta import machine_meta
-
-    trees = {"after": ROOT / "src"}
+    if _meta.stored("reading", args, table, plot):
+        if args.table and (args.out or _meta.RESULTS).joinpath("reading_svgs.json").exists():
+            print("\n" + svgs_table(_meta.load_json("reading_svgs", args)))
+        return
+    trees = {"after": _meta.ROOT / "src"}
     if args.before is not None:
         trees["before"] = args.before.resolve()
-    rows, previous = [], {}
-    with tempfile.TemporaryDirectory(prefix="foldcore-reading-") as tmp:
-        folder = args.inputs or Path(tmp)
-        folder.mkdir(parents=True, exist_ok=True)
-        for row in write_inputs(folder, args.sizes):
-            key = (row["format"], row["case"])
-            result = measure(row, *reference_plan(row, trees, previous.get(key)))
-            previous[key] = result
-            rows.append({k: v for k, v in row.items() if k != "path"} | result)
-            if "before" in result:
-                rows[-1]["same_outcome"] = result["before"]["outcome"] == \
-                    result["after"]["outcome"]
-            print(f"{row['format']} {row['case']:11s} V={row['vertices']:>8d}: " + ", ".join(
-                f"{name} {r['seconds']:.2f} s {r['rss_mb']:.0f} MB (busy {r['others_busy']:.2f})"
-                for name, r in result.items()) + f" — {result['after']['outcome']}", flush=True)
-    data = {"meta": {**machine_meta(), "runs": RUNS, "slow_s": SLOW_S, "sizes_n": list(args.sizes),
-                     "before": str(args.before) if args.before else None,
-                     "input": "tests/grids.py grid_fold(n), unit lattice, mm, faces given",
-                     "units": {"seconds": "s", "rss_mb": "MiB (VmHWM)"}},
-            "rows": rows}
-    RESULTS.mkdir(exist_ok=True)
-    (RESULTS / "reading.json").write_text(json.dumps(data, indent=1))
-    plot(rows, RESULTS / "reading.png")
+    record = _meta.Record("reading", args, runs=QUICK_RUNS if args.quick else RUNS,
+                          slow_s=SLOW_S, before=str(args.before) if args.before else None,
+                          input="tests/grids.py grid_fold(n), unit lattice, mm, faces given",
+                          units={"seconds": "s", "rss_mb": "MiB (VmHWM)"})
+    rows = grids(args, trees)
+    record.meta["sizes_n"] = sorted({r["n"] for r in rows})
+    record.write({"rows": rows}, plot)
+    print(table({"rows": rows}))
 
 
 if __name__ == "__main__":

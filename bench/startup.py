@@ -1,43 +1,43 @@
 """Start-up cost: ``import foldcore`` and time to the first iteration, cold vs warm numba cache.
 
-Every measurement is a fresh interpreter (subprocess of this script), with the
-environment of this one (``PYTHONDONTWRITEBYTECODE`` as set there).
+Every measurement is a fresh interpreter (a subprocess of this script) with
+this one's environment.
 
 * ``import``: seconds of ``import foldcore`` inside the process (interpreter
   start excluded), median of IMPORT_RUNS, against the project's src/.
 * ``first_iteration``: the small scene of tests/test_startup.py —
   ``patterns.single_hinge(panel_length=5, depth=2, angle=45, width=2)``,
-  ``thicken(p, 1.0, subdivisions=2)``, ``Simulation(mesh, p)`` (the
-  default strategy), one ``sim.run(max_iterations=1)`` (with ``hybrid`` a
-  rigid-body step) — timed inside the process from before ``import
-  foldcore`` to the end of that iteration — then ``sim.run()`` to
-  convergence (``first_result``: everything the default strategy compiles
-  for a whole fold, its L-BFGS phase's kernels included), split into import / lazy submodules / pattern +
-  thicken / Simulation(...) / step; ``process_s`` is the whole subprocess
-  wall time seen from here (interpreter start and exit included).
+  ``thicken(p, 1.0, subdivisions=2)``, ``Simulation(mesh, p)`` (the default
+  strategy), one ``sim.run(max_iterations=1)`` — timed inside the process
+  from before ``import foldcore`` to the end of that iteration, then
+  ``sim.run()`` to convergence (``first_result``: everything the default
+  strategy compiles for a whole fold); split into import / lazy submodules /
+  pattern + thicken / Simulation(...) / step; ``process_s`` is the whole
+  subprocess's wall time seen from here (interpreter start and exit
+  included).
 
-Cache states (numba ``cache=True`` writes ``__pycache__/*.nbi|*.nbc`` next
-to the sources; the project's own cache is never touched):
+Cache states (numba ``cache=True`` writes ``__pycache__/*.nbi|*.nbc`` next to
+the sources; the project's own cache is never touched):
 
 * ``cold_copy``: src/ copied to a temp dir without its ``__pycache__``
-  folders and put first on PYTHONPATH (the editable install is a plain .pth
-  path entry, which PYTHONPATH precedes; checked via ``foldcore.__file__``).
-  A fresh copy per run, COLD_RUNS runs.
-* ``cold_numba_cache_dir``: the project's src/ with ``NUMBA_CACHE_DIR`` set
-  to an empty temp dir (numba then reads and writes only there), one run.
-* ``warm``: the last ``cold_copy`` copy again, its cache now filled; median
-  of WARM_RUNS runs.
+  folders and put first on PYTHONPATH (checked via ``foldcore.__file__``); a
+  fresh copy per run, COLD_RUNS runs;
+* ``cold_numba_cache_dir``: the project's src/ with ``NUMBA_CACHE_DIR`` set to
+  an empty temp dir (numba then reads and writes only there), one run;
+* ``warm``: the last ``cold_copy`` copy again, its cache now filled; one
+  warm-up run, then the median of WARM_RUNS runs.
 
-Each run reports every numba dispatcher of the loaded ``foldcore``/``elements``
-modules with its compiled signatures, cache hits (loaded) and cache misses
-(compiled), beside the list of ``@njit`` functions found in the sources: what
-the scene never calls is neither compiled nor loaded. Seconds throughout.
-The machine is shared: before each subprocess this waits (up to 300 s, see
-``scaling.wait_for_quiet``) for other jobs to use < 25 % of the cores and
-records ``others_busy_during`` per run (share of the cores other processes
-used meanwhile). Writes bench/results/startup.json.
+The kernels a run compiled are read off the cache files it wrote (index
+files ``module.function-line.pyXY.nbi``), beside the ``@njit`` functions
+found in the sources: what the scene never calls is neither compiled nor
+written. Before each subprocess this waits (up to PATIENCE_S) for other jobs to
+use < 25 % of the cores and records ``others_busy_during`` per run (the share
+of the cores other processes used meanwhile). Seconds throughout.
 
-Run: ``.venv/bin/python bench/startup.py`` (~1 min on a quiet machine).
+Run: ``python bench/startup.py`` (~1.5 min) or ``--quick`` (no cold runs:
+imports and warm runs against the project's own cache); writes
+bench/results/startup.json and .png; ``--table`` prints the table of
+docs/benchmarks.md from the JSON.
 """
 from __future__ import annotations
 
@@ -46,21 +46,19 @@ import os
 import re
 import resource
 import shutil
-import statistics
 import subprocess
 import sys
 import tempfile
 import time
 from pathlib import Path
 
-from foldcore.strategies import DEFAULT_SOLVER
+import _meta
 
-ROOT = Path(__file__).resolve().parent.parent
-SRC = ROOT / "src"
-RESULTS = Path(__file__).parent / "results"
-IMPORT_RUNS = 5
-COLD_RUNS = 2
-WARM_RUNS = 3
+SRC = _meta.ROOT / "src"
+IMPORT_RUNS, COLD_RUNS, WARM_RUNS = 5, 2, 3
+QUICK_IMPORT_RUNS, QUICK_WARM_RUNS = 3, 2
+PATIENCE_S = 300.0  # longest wait for a quiet machine before each run (--quick: none)
+PARTS = ("import", "submodules", "pattern_thicken", "simulation", "step", "first_result")
 
 IMPORT_PROBE = """
 import json, sys, time
@@ -87,37 +85,40 @@ sim.run(tolerance=0.0, max_iterations=1)
 t5 = time.perf_counter()
 sim.run()
 t6 = time.perf_counter()
-
 import json, sys
-from numba.core.registry import CPUDispatcher
-kernels = {}
-for name, module in sorted(sys.modules.items()):
-    if not (name.startswith("foldcore") or name.startswith("elements")) or module is None:
-        continue
-    for attr, value in vars(module).items():
-        if isinstance(value, CPUDispatcher) and value.__module__ == name:
-            stats = value.stats
-            kernels[name + "." + attr] = {
-                "signatures": len(value.signatures),
-                "cache_hits": sum(stats.cache_hits.values()),
-                "cache_misses": sum(stats.cache_misses.values()),
-                "cache_path": stats.cache_path}
 print(json.dumps({
     "seconds": {"import": t1 - t0, "submodules": t2 - t1, "pattern_thicken": t3 - t2,
                 "simulation": t4 - t3, "step": t5 - t4, "first_iteration": t5 - t0,
                 "first_result": t6 - t0},
     "file": foldcore.__file__,
     "modules": sorted(n for n in sys.modules
-                      if n.startswith("foldcore") or n.startswith("elements")),
-    "kernels": kernels}))
+                      if n.startswith("foldcore") or n.startswith("elements"))}))
 """
 
 
-def probe(code: str, env: dict) -> dict:
-    from scaling import busy_seconds, wait_for_quiet
+def cache_files(root: Path) -> dict:
+    """{path: mtime_ns} of numba's cache files under ``root``."""
+    return {p: p.stat().st_mtime_ns for pattern in ("*.nbi", "*.nbc") for p in root.rglob(pattern)}
 
-    quiet = wait_for_quiet()
-    start, busy0 = time.perf_counter(), busy_seconds()
+
+def kernel_name(index: Path) -> str:
+    """``package.module.function`` of a numba index file ``module.function-line.pyXY.nbi``
+    (next to the sources in ``__pycache__``; under NUMBA_CACHE_DIR in a folder
+    ``<package>_<hash>``)."""
+    stem = re.sub(r"-\d+\.py\d+\.nbi$", "", index.name)
+    if index.parent.name != "__pycache__":
+        return f"{index.parent.name.rsplit('_', 1)[0]}.{stem}"
+    parts = index.parent.parent.parts  # the folder holding __pycache__
+    package = parts[parts.index("src") + 1:] if "src" in parts else parts[-1:]
+    return ".".join([*package, stem])
+
+
+def probe(code: str, env: dict, cache_root: Path) -> dict:
+    """One fresh interpreter running ``code``; its JSON, the process's wall time, the load,
+    and the kernels whose cache files it wrote under ``cache_root``."""
+    quiet = _meta.wait_for_quiet(patience_s=PATIENCE_S)
+    before = cache_files(cache_root)
+    start, busy0 = time.perf_counter(), _meta.busy_seconds()
     cpu0 = resource.getrusage(resource.RUSAGE_CHILDREN)
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                           env=env, timeout=900, check=True)
@@ -126,24 +127,20 @@ def probe(code: str, env: dict) -> dict:
     cpu1 = resource.getrusage(resource.RUSAGE_CHILDREN)
     own = cpu1.ru_utime + cpu1.ru_stime - cpu0.ru_utime - cpu0.ru_stime
     out["others_busy_before"] = quiet
-    out["others_busy_during"] = max(0.0, (busy_seconds() - busy0 - own) / (wall * os.cpu_count()))
+    out["others_busy_during"] = max(0.0, (_meta.busy_seconds() - busy0 - own)
+                                    / (wall * os.cpu_count()))
+    written = [p for p, t in cache_files(cache_root).items() if before.get(p) != t]
+    out["cache_files_written"] = len(written)
+    out["compiled"] = sorted({kernel_name(p) for p in written if p.suffix == ".nbi"})
     return out
 
 
-def environment(pythonpath: Path | None = None, cache_dir: Path | None = None) -> dict:
-    env = dict(os.environ)
+def environment(pythonpath: Path, cache_dir: Path | None = None) -> dict:
+    env = dict(os.environ, PYTHONPATH=str(pythonpath))
     env.pop("NUMBA_CACHE_DIR", None)
-    if pythonpath is not None:
-        env["PYTHONPATH"] = str(pythonpath)
     if cache_dir is not None:
         env["NUMBA_CACHE_DIR"] = str(cache_dir)
     return env
-
-
-def fresh_copy(tmp: Path, tag: str) -> Path:
-    dest = tmp / tag / "src"
-    shutil.copytree(SRC, dest, ignore=shutil.ignore_patterns("__pycache__", "*.pyc"))
-    return dest
 
 
 def source_kernels(src: Path) -> list[str]:
@@ -151,88 +148,115 @@ def source_kernels(src: Path) -> list[str]:
     found = []
     for path in sorted(src.rglob("*.py")):
         module = ".".join(path.relative_to(src).with_suffix("").parts)
-        text = path.read_text()
-        for match in re.finditer(r"^@(?:numba\.)?njit[^\n]*\n(?:@[^\n]*\n)*def (\w+)", text,
-                                 re.M):
+        for match in re.finditer(r"^@(?:numba\.)?njit[^\n]*\n(?:@[^\n]*\n)*def (\w+)",
+                                 path.read_text(), re.M):
             found.append(f"{module}.{match.group(1)}")
     return found
 
 
 def summary(runs: list[dict]) -> dict:
     keys = runs[0]["seconds"]
-    return {"median_s": {k: statistics.median(r["seconds"][k] for r in runs) for k in keys},
-            "process_median_s": statistics.median(r["process_s"] for r in runs),
-            "compiled": sorted(k for k, v in runs[0]["kernels"].items() if v["cache_misses"]),
-            "loaded": sorted(k for k, v in runs[0]["kernels"].items() if v["cache_hits"]),
-            "runs": runs}
+    return {"median_s": {k: _meta.median(r["seconds"][k] for r in runs) for k in keys},
+            "process_median_s": _meta.median(r["process_s"] for r in runs),
+            "compiled": runs[0]["compiled"], "runs": runs}
+
+
+def cold_and_warm(tmp: Path, quick: bool) -> tuple[dict, list]:
+    """Runs of RUN_PROBE per cache state (module docstring) and the source kernels."""
+    if quick:  # the project's own cache, as warm as the last run left it
+        warm = _meta.repeat(lambda: probe(RUN_PROBE, environment(SRC), SRC), QUICK_WARM_RUNS)
+        return {"warm": summary(warm)}, source_kernels(SRC)
+    cold, copy = [], None
+    for i in range(COLD_RUNS):
+        copy = tmp / f"cold{i}" / "src"
+        shutil.copytree(SRC, copy, ignore=shutil.ignore_patterns("__pycache__", "*.pyc"))
+        cold.append(probe(RUN_PROBE, environment(copy), copy))
+        assert cold[-1]["file"].startswith(str(copy)), cold[-1]["file"]
+        print(f"cold (copy {i}): first result {cold[-1]['seconds']['first_result']:.2f} s, "
+              f"compiled {len(cold[-1]['compiled'])}", flush=True)
+    cache_dir = tmp / "numba_cache"
+    cache_dir.mkdir()
+    cold_dir = [probe(RUN_PROBE, environment(SRC, cache_dir), cache_dir)]
+    warm = _meta.repeat(lambda: probe(RUN_PROBE, environment(copy), copy), WARM_RUNS)
+    states = {"cold_copy": summary(cold), "cold_numba_cache_dir": summary(cold_dir),
+              "warm": summary(warm)}
+    for state in states.values():  # temp paths mean nothing once the dir is gone
+        for r in state["runs"]:
+            r["file"] = r["file"].replace(str(tmp), "<tmp>")
+    return states, source_kernels(copy)
+
+
+def table(data: dict) -> str:
+    """Median seconds per cache state: first iteration, first result, and its parts."""
+    rows = [["`import foldcore`", f"{data['import']['median_s'] * 1e3:.1f} ms", "", "", "",
+             "", ""]]
+    for state, label in (("cold_copy", "cold cache (fresh copy of src/)"),
+                         ("cold_numba_cache_dir", "cold cache (empty NUMBA_CACHE_DIR)"),
+                         ("warm", "warm cache")):
+        if state not in data["first_iteration"]:
+            continue
+        s = data["first_iteration"][state]
+        m = s["median_s"]
+        rows.append([label, f"{m['first_iteration']:.2f} s", f"{m['first_result']:.2f} s",
+                     f"{m['submodules']:.2f} s", f"{m['step']:.2f} s",
+                     f"{s['process_median_s']:.2f} s", str(len(s["compiled"]))])
+    return _meta.markdown_table(["run", "first iteration", "first result",
+                                 "lazy submodules", "first step", "whole process",
+                                 "kernels compiled"], rows)
+
+
+def plot(data: dict, path) -> None:
+    """Per cache state, the median first result split into its parts (log scale)."""
+    plt = _meta.pyplot()
+    states = list(data["first_iteration"])
+    fig, ax = plt.subplots(figsize=(8, 1.2 + 0.8 * len(states)))
+    for k, state in enumerate(states):
+        m = dict(data["first_iteration"][state]["median_s"])
+        m["first_result"] -= m["first_iteration"]  # the rest of the fold
+        left = 0.0
+        for j, part in enumerate(PARTS):
+            label = "rest of the fold" if part == "first_result" else part.replace("_", " + ")
+            ax.barh(k, m[part], left=left, color=f"C{j}", label=label if k == 0 else None)
+            left += m[part]
+    ax.set_yticks(range(len(states)), [s.replace("_", " ") for s in states], fontsize=8)
+    ax.set_xlabel("seconds from before `import foldcore` to the first result (medians)")
+    ax.legend(fontsize=7, ncol=3)
+    ax.set_title(f"import foldcore: {data['import']['median_s'] * 1e3:.1f} ms (median)",
+                 fontsize=9)
+    _meta.save(fig, path)
 
 
 def main() -> None:
-    sys.path.insert(0, str(Path(__file__).parent))
-    from _meta import machine_meta
-
-    project = environment(SRC)
-    imports = [probe(IMPORT_PROBE, project) for _ in range(IMPORT_RUNS)]
-    print(f"import foldcore: {statistics.median(r['seconds'] for r in imports):.4f} s",
-          flush=True)
-
+    global PATIENCE_S
+    args = _meta.parser(__doc__).parse_args()
+    if _meta.stored("startup", args, table, plot):
+        return
+    if args.quick:
+        PATIENCE_S = 0.0
+    import_runs = QUICK_IMPORT_RUNS if args.quick else IMPORT_RUNS
+    record = _meta.Record(
+        "startup", args, import_runs=import_runs, cold_runs=0 if args.quick else COLD_RUNS,
+        warm_runs=QUICK_WARM_RUNS if args.quick else WARM_RUNS,
+        PYTHONDONTWRITEBYTECODE=os.environ.get("PYTHONDONTWRITEBYTECODE"),
+        scene="single_hinge(panel_length=5, depth=2, angle=45, width=2), thicken(H=1, "
+              "subdivisions=2), Simulation(mesh, p) (default strategy), run(max_iterations=1)",
+        units="seconds")
+    imports = [probe(IMPORT_PROBE, environment(SRC), SRC) for _ in range(import_runs)]
+    print(f"import foldcore: {_meta.median(r['seconds'] for r in imports):.4f} s", flush=True)
     with tempfile.TemporaryDirectory(prefix="foldcore-startup-") as tmp:
-        tmp = Path(tmp)
-        cold, copy = [], None
-        for i in range(COLD_RUNS):
-            copy = fresh_copy(tmp, f"cold{i}")
-            cold.append(probe(RUN_PROBE, environment(copy)))
-            assert cold[-1]["file"].startswith(str(copy)), cold[-1]["file"]
-            print(f"cold (copy {i}): first result {cold[-1]['seconds']['first_result']:.2f} s, "
-                  f"first iteration {cold[-1]['seconds']['first_iteration']:.2f} s"
-                  f", compiled {sum(v['cache_misses'] > 0 for v in cold[-1]['kernels'].values())}",
-                  flush=True)
-        cache_dir = tmp / "numba_cache"
-        cache_dir.mkdir()
-        cold_dir = [probe(RUN_PROBE, environment(SRC, cache_dir))]
-        print(f"cold (NUMBA_CACHE_DIR): first result {cold_dir[0]['seconds']['first_result']:.2f}"
-              f" s, first iteration {cold_dir[0]['seconds']['first_iteration']:.2f} s", flush=True)
-        warm = [probe(RUN_PROBE, environment(copy)) for _ in range(WARM_RUNS)]
-        print(f"warm: first result "
-              f"{statistics.median(r['seconds']['first_result'] for r in warm):.2f} s, first "
-              f"iteration {statistics.median(r['seconds']['first_iteration'] for r in warm):.2f} s",
-              flush=True)
-        kernels = source_kernels(copy)
-
-    for runs in (cold, cold_dir, warm):
-        for r in runs:  # temp paths mean nothing once the dir is gone
-            r["file"] = r["file"].replace(str(tmp), "<tmp>")
-            for v in r["kernels"].values():
-                v["cache_path"] = (v["cache_path"] or "").replace(str(tmp), "<tmp>")
-    cold_kernels = cold[0]["kernels"]
-    data = {
-        "meta": {**machine_meta(), "import_runs": IMPORT_RUNS, "cold_runs": COLD_RUNS,
-                 "warm_runs": WARM_RUNS,
-                 "PYTHONDONTWRITEBYTECODE": os.environ.get("PYTHONDONTWRITEBYTECODE"),
-                 "scene": "single_hinge(panel_length=5, depth=2, angle=45, width=2), "
-                          "thicken(H=1, subdivisions=2), Simulation(mesh, p) (default "
-                          f"solver, {DEFAULT_SOLVER}), run(max_iterations=1)",
-                 "units": "seconds"},
-        "import": {"median_s": statistics.median(r["seconds"] for r in imports),
-                   "runs_s": [r["seconds"] for r in imports],
-                   "process_median_s": statistics.median(r["process_s"] for r in imports),
-                   "numba_imported": imports[0]["numba_imported"]},
-        "first_iteration": {"cold_copy": summary(cold),
-                            "cold_numba_cache_dir": summary(cold_dir),
-                            "warm": summary(warm)},
-        "cold_over_warm": (statistics.median(r["seconds"]["first_iteration"] for r in cold)
-                           / statistics.median(r["seconds"]["first_iteration"] for r in warm)),
-        "kernels_in_sources": kernels,
-        # cold: every kernel the scene reaches is compiled (callees too); warm: only the
-        # entry points are loaded, their callees are linked into the cached code
-        "kernels_never_touched": sorted(
-            k for k in kernels
-            if k not in cold_kernels or not cold_kernels[k]["signatures"]),
-    }
-    RESULTS.mkdir(exist_ok=True)
-    (RESULTS / "startup.json").write_text(json.dumps(data, indent=1))
-    print("compiled cold:", data["first_iteration"]["cold_copy"]["compiled"])
-    print("never touched:", data["kernels_never_touched"])
+        states, kernels = cold_and_warm(Path(tmp), args.quick)
+    compiled = set(states.get("cold_copy", states["warm"])["compiled"])
+    data = {"import": {"median_s": _meta.median(r["seconds"] for r in imports),
+                       "runs_s": [r["seconds"] for r in imports],
+                       "process_median_s": _meta.median(r["process_s"] for r in imports),
+                       "numba_imported": imports[0]["numba_imported"]},
+            "first_iteration": states, "kernels_in_sources": kernels}
+    if "cold_copy" in states:
+        data["cold_over_warm"] = (states["cold_copy"]["median_s"]["first_iteration"]
+                                  / states["warm"]["median_s"]["first_iteration"])
+        data["kernels_never_touched"] = sorted(k for k in kernels if k not in compiled)
+    record.write(data, plot)
+    print(table(data))
 
 
 if __name__ == "__main__":

@@ -1,8 +1,8 @@
-"""Time to a converged fold, per strategy and size, beside the bare solve (issue 17).
+"""Time to a converged fold, per strategy and size, beside the bare solve.
 
 What a user waits for: wall time and iterations from the thick mesh to a fold
-that meets the accuracy issue's tolerance (largest angle error ≤ 0.01° against
-the closed form), and the peak memory of the process.
+that meets the accuracy benchmark's tolerance (largest angle error ≤ 0.01°
+against the closed form), and the peak memory of the process.
 
 Cases (the accuracy and convergence benchmarks' definitions, imported from
 them):
@@ -19,71 +19,66 @@ Each run is a fresh process (``--probe``) with the library's defaults but the
 strategy (hybrid, rigid, lbfgs): ``Simulation(mesh, pattern,
 solver=…).run(tolerance=1e-8, max_iterations=budget)``, the command line's
 tolerance; budget 10 000 (lbfgs 2 000: it never reaches these folds from
-flat). Reported: wall time of ``run`` (setup excluded; K is factorised at
-its first use, so inside ``run`` for the strategies that solve with it —
-lbfgs, and hybrid's finish where it hands over — and never for a rigid-body
-fold), iterations, ``converged``, largest angle error (degrees), the paper
-map's bare solve of K (N × 3 right-hand side, median of 20, the
-host-independent yardstick: time / bare solve), thick vertices, peak RSS of
-the fold (read before the bare solves, which factorise K where the run did
-not) and its growth over the RSS before the mesh is built (per thick vertex).
+flat). Reported: wall time of ``run`` (set-up excluded; K is factorised at
+its first use, so inside ``run`` for the strategies that solve with it),
+iterations, ``converged``, largest angle error (degrees), the bare solve of
+the paper map's K (``Result.timings_s["bare_solve"]`` of a ``paper``
+simulation of the same mesh after one iteration: the host-independent
+yardstick, time / bare solve), thick vertices, peak RSS of the fold (read
+before that) and its growth over the RSS before the mesh is built (per thick
+vertex).
 
-Warm: the project's numba cache (the README's set-up fills it); runs of one
-size interleaved over strategies, ``RUNS`` rounds for the small cases, one for
-Miura 20 × 20 and 50 × 50. Cold: Miura 10 × 10 under the default strategy with
-``NUMBA_CACHE_DIR`` set to an empty folder (everything compiled in-process).
-The machine is shared: the share of the cores other processes used is
-recorded before each run (``others_busy``).
+Warm: the project's numba cache; one warm-up process first, then the runs of
+one case interleaved over the strategies, RUNS rounds for the small cases,
+one for Miura 20 × 20 and 50 × 50; medians. Cold: Miura 10 × 10 under the
+default strategy with ``NUMBA_CACHE_DIR`` set to an empty folder
+(everything compiled in-process). The share of the cores other processes
+used is recorded before each run (``others_busy``).
 
-Memory, fixed and marginal (``--memory``; stored under ``memory``): the
-growth above counts what any first fold in a process pays once (numba's and
-LLVM's runtime, the first call of each kernel: ≈ 0.1 GB whatever the size),
-so per thick vertex it overstates what a bigger sheet costs. A fresh process
-per size folds a small warm-up sheet (``WARMUP_CASE``) with the default
-strategy first, then the case; reported: the RSS before anything (``start``),
-after the warm-up (``fixed_mb`` = its growth) and the case's peak growth over
-the RSS after the warm-up, per thick vertex (``marginal_kb_per_vertex``).
+Memory, fixed and marginal (stored under ``memory``): the growth above counts
+what any first fold in a process pays once (numba's and LLVM's runtime, the
+first call of each kernel), so per thick vertex it overstates what a bigger
+sheet costs. A fresh process per size folds a small warm-up sheet
+(WARMUP_CASE) with the default strategy first, then the case; reported: the
+RSS before anything (``start_mb``), after the warm-up (``fixed_mb`` = its
+growth) and the case's peak growth over the RSS after the warm-up, per thick
+vertex (``marginal_kb_per_vertex``).
 
-Writes bench/results/time_to_solution.json and .png; ``--table`` prints the
-README's table from the JSON (and the memory table when measured); ``--rerun
-lbfgs`` runs only the strategies named (comma-separated) again and replaces
-their rows; ``--memory`` runs the memory probes and stores them.
-
-Run: ``.venv/bin/python bench/time_to_solution.py`` (~15 min).
+Run: ``python bench/time_to_solution.py`` (~15 min) or ``--quick``; writes
+bench/results/time_to_solution.json and .png; ``--table`` prints the tables
+of docs/benchmarks.md from the JSON.
 """
 from __future__ import annotations
 
 import json
 import os
 import resource
-import statistics
 import subprocess
 import sys
 import tempfile
 import time
-from pathlib import Path
 
 import numpy as np
 
-HERE = Path(__file__).resolve().parent
-RESULTS = HERE / "results"
+import _meta
+
 STRATEGIES = ("hybrid", "rigid", "lbfgs")
 TOLERANCE, BUDGET, LBFGS_BUDGET = 1e-8, 10_000, 2_000
 ACCURACY_DEG = 0.01
 RUNS = 3
 CASES = ("vertex", "waterbomb", "miura10", "miura20", "miura50")
 ONE_RUN = ("miura20", "miura50")
-BARE_SOLVES = 20
 WARMUP_CASE = "miura4"
 MEMORY_CASES = ("miura10", "miura20", "miura50")
+#: --quick: cases, rounds, L-BFGS budget, memory cases; no cold run
+QUICK = {"cases": ("vertex", "miura10"), "runs": 1, "lbfgs_budget": 200,
+         "memory": ("miura10",)}
 
 
 def make_case(name: str):
     """(pattern, mesh, closed-form angles (C,), crease indices (C,)) of a case."""
-    sys.path.insert(0, str(HERE))
     import accuracy
     import convergence
-
     from foldcore import thicken
 
     if name == "waterbomb":
@@ -102,37 +97,31 @@ def current_rss_mb() -> float:
         return int(fh.read().split()[1]) * os.sysconf("SC_PAGE_SIZE") / 2 ** 20
 
 
-def probe(case: str, strategy: str) -> dict:
+def probe(case: str, strategy: str, budget: int) -> dict:
     """One run in this process (see the module docstring); JSON-ready."""
-    from foldcore.simulation import Simulation
+    from foldcore import Simulation
 
     before = current_rss_mb()
     pattern, mesh, expected, creases = make_case(case)
     sim = Simulation(mesh, pattern, solver=strategy)
-    budget = LBFGS_BUDGET if strategy == "lbfgs" else BUDGET
     start = time.perf_counter()
     result = sim.run(tolerance=TOLERANCE, max_iterations=budget)
     seconds = time.perf_counter() - start
     error = float(np.abs(result.fold_angles_deg[creases] - expected).max())
-    peak = peak_rss_mb()  # the fold's: the bare solves below may factorise K first
-    rhs = np.random.default_rng(0).standard_normal((mesh.n_vertices, 3))
-    sim.system.factor.solve(rhs)
-    solves = []
-    for _ in range(BARE_SOLVES):
-        t = time.perf_counter()
-        sim.system.factor.solve(rhs)
-        solves.append(time.perf_counter() - t)
+    peak = peak_rss_mb()  # the fold's: the yardstick below factorises K
+    paper = Simulation(mesh, pattern, solver="paper")
+    bare = paper.run(tolerance=0.0, max_iterations=1).timings_s["bare_solve"]
     return {"case": case, "strategy": strategy, "seconds": seconds,
             "iterations": int(result.iterations), "converged": bool(result.converged),
             "reason": result.reason, "error_deg": error, "accurate": bool(error <= ACCURACY_DEG),
-            "bare_solve_s": statistics.median(solves), "thick_vertices": int(mesh.n_vertices),
+            "bare_solve_s": bare, "thick_vertices": int(mesh.n_vertices),
             "peak_rss_mb": peak, "rss_growth_mb": peak - before,
             "kb_per_thick_vertex": (peak - before) * 1024.0 / mesh.n_vertices}
 
 
 def memory_probe(case: str) -> dict:
-    """Fixed and marginal memory of a hybrid fold of ``case`` (module docstring)."""
-    from foldcore.simulation import Simulation
+    """Fixed and marginal memory of a default fold of ``case`` (module docstring)."""
+    from foldcore import Simulation
 
     start = current_rss_mb()
     pattern, mesh, _, _ = make_case(WARMUP_CASE)
@@ -150,51 +139,18 @@ def memory_probe(case: str) -> dict:
             "iterations": int(result.iterations), "error_deg": error}
 
 
-def memory() -> None:
-    """Run ``memory_probe`` per size in fresh processes; store under ``memory``."""
-    from _meta import machine_meta
-
-    rows = []
-    for case in MEMORY_CASES:
-        out = subprocess.run([sys.executable, __file__, "--memory-probe", case],
-                             capture_output=True, text=True, check=True)
-        row = json.loads(out.stdout.strip().splitlines()[-1])
-        print(f"  {case:9s} fixed {row['fixed_mb']:.1f} MB  marginal {row['marginal_mb']:.1f} MB"
-              f" = {row['marginal_kb_per_vertex']:.2f} kB/vertex  peak {row['peak_rss_mb']:.0f} MB",
-              flush=True)
-        rows.append(row)
-    path = RESULTS / "time_to_solution.json"
-    data = json.loads(path.read_text())
-    data["memory"] = {"meta": {**machine_meta(), "date": time.strftime("%Y-%m-%d")},
-                      "rows": rows}
-    path.write_text(json.dumps(data, indent=1))
-    print(memory_table())
+def child(*argv, env=None) -> dict:
+    """The JSON line a fresh interpreter running this file with ``argv`` prints."""
+    out = subprocess.run([sys.executable, __file__, *map(str, argv)], capture_output=True,
+                         text=True, env=env, check=True)
+    return json.loads(out.stdout.strip().splitlines()[-1])
 
 
-def memory_table(path: Path = RESULTS / "time_to_solution.json") -> str:
-    """README table of the memory probes: fixed MB, marginal MB and kB per thick vertex."""
-    from _meta import markdown_table
-
-    data = json.loads(path.read_text())
-    if "memory" not in data:
-        return ""
-    return markdown_table(
-        ["case", "thick vertices", "fixed (MB)", "marginal (MB)", "marginal kB / thick vertex",
-         "peak RSS (MB)"],
-        [[r["case"], f"{r['thick_vertices']:,}", f"{r['fixed_mb']:.0f}",
-          f"{r['marginal_mb']:.1f}", f"{r['marginal_kb_per_vertex']:.2f}",
-          f"{r['peak_rss_mb']:.0f}"] for r in data["memory"]["rows"]])
-
-
-def run_probe(case: str, strategy: str, env=None) -> dict:
+def run_probe(case: str, strategy: str, budget: int, env=None) -> dict:
     """``probe`` in a fresh interpreter; adds the process wall time and the load."""
-    from scaling import others_busy
-
-    busy = others_busy(1.0)
+    busy = _meta.others_busy(1.0)
     start = time.perf_counter()
-    out = subprocess.run([sys.executable, __file__, "--probe", case, strategy],
-                         capture_output=True, text=True, env=env, check=True)
-    row = json.loads(out.stdout.strip().splitlines()[-1])
+    row = child("--probe", case, strategy, budget, env=env)
     row.update(process_s=time.perf_counter() - start, others_busy=busy)
     print(f"  {case:9s} {strategy:6s} {row['seconds']:8.2f} s  its {row['iterations']:5d}  "
           f"err {row['error_deg']:.2g}°  {row['seconds'] / row['bare_solve_s']:9.0f} bare solves  "
@@ -204,32 +160,19 @@ def run_probe(case: str, strategy: str, env=None) -> dict:
 
 def summarise(rows: list) -> list:
     """Median-time row per (case, strategy), with every run's seconds."""
-    from _meta import median_run
-
     out = []
     for case in CASES:
         for strategy in STRATEGIES:
             runs = [r for r in rows if r["case"] == case and r["strategy"] == strategy]
-            if not runs:
-                continue
-            row = median_run(runs)
-            row["bare_solves"] = row["seconds"] / row["bare_solve_s"]
-            out.append(row)
+            if runs:
+                row = _meta.median_run(runs)
+                row["bare_solves"] = row["seconds"] / row["bare_solve_s"]
+                out.append(row)
     return out
 
 
-def cold_run() -> dict:
-    with tempfile.TemporaryDirectory() as cache:
-        env = {**os.environ, "NUMBA_CACHE_DIR": cache}
-        return run_probe("miura10", "hybrid", env)
-
-
-def plot(data: dict, path: Path) -> None:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+def plot(data: dict, path) -> None:
+    plt = _meta.pyplot()
     fig, (left, right) = plt.subplots(1, 2, figsize=(11, 4.2))
     miura = [c for c in CASES if c.startswith("miura")]
     for strategy, style in zip(STRATEGIES, ("C4o-", "C3s--", "C2^:")):
@@ -242,24 +185,24 @@ def plot(data: dict, path: Path) -> None:
             if not r["accurate"]:
                 left.annotate(f"{r['error_deg']:.2g}°", (r["thick_vertices"], r["seconds"]),
                               fontsize=7)
-    left.set_xlabel("thick vertices (Miura 10, 20, 50)")
+    left.set_xlabel("thick vertices (Miura n × n)")
     left.set_ylabel("wall time to the fold, s (warm)")
     right.set_xlabel("thick vertices")
     right.set_ylabel("wall time / bare solve of K")
     left.legend()
     left.set_title("time to a converged fold (labels: error if > 0.01°)", fontsize=9)
     right.set_title("host-independent: in bare solves", fontsize=9)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
+    _meta.save(fig, path, dpi=120)
 
 
-def table(path: Path = RESULTS / "time_to_solution.json") -> str:
-    """README table: per case and strategy, time (s), iterations, error, bare solves."""
-    from _meta import markdown_table
-
-    data = json.loads(path.read_text())
+def table(data: dict) -> str:
+    """Per case and strategy: time (s), iterations, error; hybrid's bare solves, memory."""
     rows = []
     for case in CASES:
+        hybrid = next((r for r in data["warm"] if r["case"] == case
+                       and r["strategy"] == "hybrid"), None)
+        if hybrid is None:
+            continue
         cells = [case]
         for strategy in STRATEGIES:
             r = next((r for r in data["warm"] if r["case"] == case
@@ -273,72 +216,65 @@ def table(path: Path = RESULTS / "time_to_solution.json") -> str:
             elif not r["converged"]:
                 mark += f", not converged ({r.get('reason', 'budget')})"
             cells.append(f"{r['seconds']:.3g} s, {r['iterations']} its{mark}")
-        r = next(r for r in data["warm"] if r["case"] == case and r["strategy"] == "hybrid")
-        cells += [f"{r['thick_vertices']:,}", f"{r['bare_solves']:,.0f}",
-                  f"{r['kb_per_thick_vertex']:.2f}"]
+        cells += [f"{hybrid['thick_vertices']:,}", f"{hybrid['bare_solves']:,.0f}",
+                  f"{hybrid['kb_per_thick_vertex']:.2f}"]
         rows.append(cells)
-    return markdown_table(["case", *STRATEGIES, "thick vertices", "hybrid / bare solve",
-                           "kB / thick vertex (hybrid)"], rows)
+    return _meta.markdown_table(["case", *STRATEGIES, "thick vertices", "hybrid / bare solve",
+                                 "kB / thick vertex (hybrid)"], rows)
 
 
-def rerun(strategies: list) -> None:
-    """Run only ``strategies`` again (same cases and rounds) and replace their rows in
-    the stored JSON; the rerun's date and machine are recorded under ``meta.reruns``
-    (the other strategies' rows keep their own run's)."""
-    from _meta import machine_meta
+def cold_line(data: dict) -> str:
+    """The cold-cache run, when measured."""
+    c = data.get("cold")
+    return "" if c is None else (f"cold numba cache ({c['case']}, {c['strategy']}, everything "
+                                 f"compiled in the process): {c['seconds']:.3g} s, "
+                                 f"{c['iterations']} iterations")
 
-    path = RESULTS / "time_to_solution.json"
-    data = json.loads(path.read_text())
-    rows = [r for r in data["runs"] if r["strategy"] not in strategies]
-    for case in CASES:
-        print(case, flush=True)
-        for _ in range(1 if case in ONE_RUN else RUNS):
-            for strategy in strategies:
-                rows.append(run_probe(case, strategy))
-    data["meta"].setdefault("reruns", []).append(
-        {**machine_meta(), "date": time.strftime("%Y-%m-%d"), "strategies": strategies})
-    data.update(warm=summarise(rows), runs=rows)
-    path.write_text(json.dumps(data, indent=1))
-    plot(data, RESULTS / "time_to_solution.png")
-    print(table())
+
+def memory_table(data: dict) -> str:
+    """Fixed MB, marginal MB and kB per thick vertex of the memory probes."""
+    return _meta.markdown_table(
+        ["case", "thick vertices", "fixed (MB)", "marginal (MB)", "marginal kB / thick vertex",
+         "peak RSS (MB)"],
+        [[r["case"], f"{r['thick_vertices']:,}", f"{r['fixed_mb']:.0f}",
+          f"{r['marginal_mb']:.1f}", f"{r['marginal_kb_per_vertex']:.2f}",
+          f"{r['peak_rss_mb']:.0f}"] for r in data.get("memory", {}).get("rows", [])])
 
 
 def main() -> None:
-    sys.path.insert(0, str(HERE))
-    from _meta import machine_meta
-
+    args = _meta.parser(__doc__).parse_args()
+    if _meta.stored("time_to_solution", args, lambda data: "\n\n".join(
+            [table(data), cold_line(data), memory_table(data)]), plot):
+        return
+    q = QUICK if args.quick else {"cases": CASES, "runs": RUNS, "lbfgs_budget": LBFGS_BUDGET,
+                                  "memory": MEMORY_CASES}
+    record = _meta.Record("time_to_solution", args, tolerance=TOLERANCE, budget=BUDGET,
+                          lbfgs_budget=q["lbfgs_budget"], accuracy_deg=ACCURACY_DEG,
+                          runs=q["runs"], runs_one=list(ONE_RUN), warmup_processes=1)
+    child("--probe", q["cases"][0], "hybrid", BUDGET)  # warm-up: page cache, .pyc
     rows = []
-    for case in CASES:
+    for case in q["cases"]:
         print(case, flush=True)
-        for _ in range(1 if case in ONE_RUN else RUNS):
+        for _ in range(1 if case in ONE_RUN else q["runs"]):
             for strategy in STRATEGIES:
-                rows.append(run_probe(case, strategy))
-    print("cold cache", flush=True)
-    cold = cold_run()
-    data = {"meta": {**machine_meta(), "date": time.strftime("%Y-%m-%d"),
-                     "tolerance": TOLERANCE, "budget": BUDGET, "lbfgs_budget": LBFGS_BUDGET,
-                     "accuracy_deg": ACCURACY_DEG},
-            "warm": summarise(rows), "runs": rows, "cold": cold}
-    RESULTS.mkdir(exist_ok=True)
-    (RESULTS / "time_to_solution.json").write_text(json.dumps(data, indent=1))
-    plot(data, RESULTS / "time_to_solution.png")
-    print(table())
+                budget = q["lbfgs_budget"] if strategy == "lbfgs" else BUDGET
+                rows.append(run_probe(case, strategy, budget))
+    data = {"warm": summarise(rows), "runs": rows}
+    if not args.quick:
+        print("cold cache", flush=True)
+        with tempfile.TemporaryDirectory() as cache:
+            data["cold"] = run_probe("miura10", "hybrid", BUDGET,
+                                     env={**os.environ, "NUMBA_CACHE_DIR": cache})
+    print("memory", flush=True)
+    data["memory"] = {"rows": [child("--memory-probe", case) for case in q["memory"]]}
+    record.write(data, plot)
+    print("\n\n".join([table(data), cold_line(data), memory_table(data)]))
 
 
 if __name__ == "__main__":
-    if len(sys.argv) > 1 and sys.argv[1] == "--probe":
-        print(json.dumps(probe(sys.argv[2], sys.argv[3])))
-    elif len(sys.argv) > 1 and sys.argv[1] == "--memory-probe":
+    if sys.argv[1:2] == ["--probe"]:
+        print(json.dumps(probe(sys.argv[2], sys.argv[3], int(sys.argv[4]))))
+    elif sys.argv[1:2] == ["--memory-probe"]:
         print(json.dumps(memory_probe(sys.argv[2])))
-    elif len(sys.argv) > 1 and sys.argv[1] == "--memory":
-        sys.path.insert(0, str(HERE))
-        memory()
-    elif len(sys.argv) > 1 and sys.argv[1] == "--table":
-        sys.path.insert(0, str(HERE))
-        print(table())
-        print(memory_table())
-    elif len(sys.argv) > 2 and sys.argv[1] == "--rerun":
-        sys.path.insert(0, str(HERE))
-        rerun(sys.argv[2].split(","))
     else:
         main()

@@ -1,9 +1,11 @@
-"""Fuzz counts of issue 18: corrupted inputs through the readers and the CLI.
+"""Fuzz the readers and the command line with corrupted inputs (a dev tool).
 
-Readers (in-process): FOLD, OBJ, STL (ASCII and binary), hinge files and
-result files (``read_result``), each corrupted 1–3 times by plain random
-mutations (fixed seed) of real files: the hinge scene and a degree-4 vertex
-(their result files written by ``foldcore simulate -o``). Counted per
+Readers (in-process, the public ones): FOLD (``foldcore.io.read_fold_file``,
+what ``foldcore simulate`` reads), OBJ, STL (ASCII and binary) and hinge
+files (``foldcore.read``) and result files
+(``foldcore.fabrication.read_result``), each corrupted 1–3 times by plain
+random mutations (fixed seed) of real files: the hinge scene and a degree-4
+vertex (their result files written by ``foldcore simulate -o``). Counted per
 reader: accepted, refused (a FoldcoreError), unhandled (any other
 exception, by type), hangs (longer than ``--case-seconds``, SIGALRM),
 multi-line refusals and refusals not naming the file.
@@ -15,8 +17,11 @@ tracebacks on stderr, hangs (``--process-seconds``), refusals of more than
 one line, leftovers (after a refusal any file in the folder; after any exit
 a temporary file).
 
-Run: ``PYTHONPATH=src python bench/fuzz.py [--reader-cases N] [--cli-cases N]``;
-writes bench/results/fuzz.json.
+Run: ``python tools/fuzz.py`` (a few minutes: READER_CASES per reader,
+CLI_CASES per command) or ``--long`` (the recorded run: 5 000 per reader, 15
+per command, ~4 min on 2 cores; writes tools/results/fuzz.json);
+``--reader-cases N``, ``--cli-cases N``, ``--out FILE`` set them. Exits 1 if
+anything unhandled, hung, left over or refused in more than one line.
 """
 from __future__ import annotations
 
@@ -35,7 +40,10 @@ import warnings
 from collections import Counter
 from pathlib import Path
 
-RESULTS = Path(__file__).resolve().parent / "results"
+ROOT = Path(__file__).resolve().parents[1]
+RESULTS = ROOT / "tools" / "results"
+READER_CASES, CLI_CASES = 500, 5
+LONG_READER_CASES, LONG_CLI_CASES = 5000, 15
 NASTY = [float("nan"), float("inf"), -float("inf"), 1e308, -1e308, 5e-324, 1e-300, 1e300,
          0.0, -0.0, -1.0, 10 ** 400, -(2 ** 63), 2 ** 64, True, False, None, "", "x", "1",
          [], {}, [[]], [None], [1, 2, 3], {"a": [1]}, 0.5, 180.0, 360.0, 3, -3]
@@ -127,10 +135,8 @@ def json_bytes(d) -> bytes:
 # ------------------------------------------------------------------ base files
 def base_files(folder: Path) -> dict:
     """Real files of the hinge scene and a degree-4 vertex; result files by simulate -o."""
-    from foldcore import patterns
-    from foldcore.cli import main
-    from foldcore.fabrication import stl_bytes  # noqa: F401  (imports numba kernels once)
-    from foldcore.io import write_fold, write_hinges, write_obj
+    from foldcore import patterns, write_fold
+    from foldcore.io import write_hinges, write_obj
 
     scenes = {"hinge": (patterns.single_hinge(panel_length=5.0, depth=2.0, angle=90.0,
                                               width=2.0), "4"),
@@ -142,11 +148,10 @@ def base_files(folder: Path) -> dict:
         write_fold(folder / f"{name}.fold", p, thickness=1.0)
         write_obj(folder / f"{name}.obj", p)
         write_hinges(folder / f"{name}.hinges", p)
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            assert main(["simulate", str(folder / f"{name}.fold"), "-o",
-                         str(folder / f"{name}.result.fold"), "--subdivisions", k,
-                         "--max-iterations", "30"]) == 0
+        subprocess.run([sys.executable, "-m", "foldcore", "simulate", str(folder / f"{name}.fold"),
+                        "-o", str(folder / f"{name}.result.fold"), "--subdivisions", k,
+                        "--max-iterations", "30"], env=child_env(), capture_output=True,
+                       check=True)
         out["fold"].append(json.loads((folder / f"{name}.fold").read_text()))
         out["result"].append(json.loads((folder / f"{name}.result.fold").read_text()))
         out["obj"].append((folder / f"{name}.obj").read_text())
@@ -156,22 +161,27 @@ def base_files(folder: Path) -> dict:
         tris = [[v[f[0]], v[f[j]], v[f[j + 1]]] for f in p.faces for j in range(1, len(f) - 1)]
         out["stl_ascii"].append(_ascii_stl(tris))
         out["stl_binary"].append(_binary_stl(tris))
-        out[f"hinges_of_stl_{name}"] = _stl_hinges(out["stl_binary"][-1])
+        out[f"hinges_of_stl_{name}"] = _stl_hinges(tris)
     return out
 
 
-def _stl_hinges(data: bytes) -> str:
-    """A hinge file for a triangulated sheet: every interior edge a flat crease."""
-    import numpy as np
+def child_env() -> dict:
+    """This environment with the project's src/ first on PYTHONPATH."""
+    return {**os.environ, "PYTHONPATH": str(ROOT / "src")}
 
-    from foldcore.io.obj import mesh_edges, parse_polygons
 
-    _, faces = parse_polygons(data, "base.stl")
-    edges = mesh_edges(faces)
-    sides = Counter(tuple(sorted(e)) for f in faces
-                    for e in zip(f.tolist(), np.roll(f, -1).tolist()))
-    return "".join(f"{e} auto F\n" for e, (u, v) in enumerate(edges.tolist())
-                   if sides[tuple(sorted((u, v)))] == 2)
+def _stl_hinges(tris) -> str:
+    """A hinge file for a triangulated sheet: every interior edge a flat crease, numbered
+    as hinge files number a mesh's edges (unique face sides in order of first
+    appearance; the STL's vertices are its float32 coordinates)."""
+    first, sides = {}, Counter()
+    for t in tris:
+        corners = [tuple(struct.unpack("<2f", struct.pack("<2f", *xy))) for xy in t]
+        for a, b in zip(corners, corners[1:] + corners[:1]):
+            key = tuple(sorted((a, b)))
+            first.setdefault(key, len(first))
+            sides[key] += 1
+    return "".join(f"{e} auto F\n" for key, e in first.items() if sides[key] == 2)
 
 
 def _ascii_stl(tris) -> str:
@@ -225,8 +235,8 @@ def generated(kind: str, bases: dict, rng: random.Random):
 
 # ------------------------------------------------------------------ readers
 def read(kind: str, folder: Path):
+    import foldcore
     from foldcore.fabrication import read_result
-    from foldcore.io import read as read_pattern
     from foldcore.io import read_fold_file
 
     if kind == "fold":
@@ -234,11 +244,11 @@ def read(kind: str, folder: Path):
     if kind == "result":
         return read_result(folder / "in.result.fold")
     mesh = "in.obj" if kind in ("obj", "hinges") else "in.stl"
-    return read_pattern(folder / mesh, hinges=folder / "in.hinges")
+    return foldcore.read(folder / mesh, hinges=folder / "in.hinges")
 
 
 def fuzz_reader(kind: str, bases: dict, cases: int, seed: int, seconds: int) -> dict:
-    from foldcore.errors import FoldcoreError
+    from foldcore import FoldcoreError
 
     rng = random.Random(seed)
     counts = Counter()
@@ -298,7 +308,7 @@ def fuzz_cli(kind: str, bases: dict, cases: int, seed: int, seconds: int) -> dic
     source = {"simulate_fold": "fold", "simulate_obj": "obj"}.get(kind, "result")
     counts = Counter()
     first = {}
-    env = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[1] / "src")}
+    env = child_env()
     for case in range(cases):
         with tempfile.TemporaryDirectory() as tmp:
             folder = Path(tmp)
@@ -337,17 +347,33 @@ def fuzz_cli(kind: str, bases: dict, cases: int, seed: int, seconds: int) -> dic
             "first_messages": first}
 
 
-def main(argv=None) -> None:
+def failures(data: dict) -> int:
+    """Cases that broke a promise: unhandled, hung, multi-line, not naming the file,
+    exit codes but 0/2, tracebacks, leftovers, temporary files."""
+    keys = ("unhandled", "hangs", "multi_line", "not_naming_the_file", "bad_exit",
+            "tracebacks", "leftovers", "temp_files")
+    return sum(block.get(k, 0) for part in ("readers", "cli") for block in data[part].values()
+               for k in keys)
+
+
+def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--reader-cases", type=int, default=2000, help="per reader")
-    parser.add_argument("--cli-cases", type=int, default=25, help="per CLI command")
+    parser.add_argument("--long", action="store_true",
+                        help=f"{LONG_READER_CASES} cases per reader, {LONG_CLI_CASES} per "
+                             "command, written to tools/results/fuzz.json")
+    parser.add_argument("--reader-cases", type=int, help=f"per reader (default {READER_CASES})")
+    parser.add_argument("--cli-cases", type=int, help=f"per CLI command (default {CLI_CASES})")
     parser.add_argument("--seed", type=int, default=18)
     parser.add_argument("--case-seconds", type=int, default=20)
     parser.add_argument("--process-seconds", type=int, default=120)
-    parser.add_argument("--out", default=str(RESULTS / "fuzz.json"))
+    parser.add_argument("--out", type=Path, help="JSON written (default with --long: "
+                                                 "tools/results/fuzz.json)")
     args = parser.parse_args(argv)
-    sys.path.insert(0, str(Path(__file__).resolve().parent))
-    from _meta import machine_meta
+    reader_cases = args.reader_cases or (LONG_READER_CASES if args.long else READER_CASES)
+    cli_cases = args.cli_cases or (LONG_CLI_CASES if args.long else CLI_CASES)
+    out = args.out or (RESULTS / "fuzz.json" if args.long else None)
+    sys.path.insert(0, str(ROOT / "bench"))
+    import _meta
 
     start = time.perf_counter()
     with tempfile.TemporaryDirectory() as tmp:
@@ -355,25 +381,28 @@ def main(argv=None) -> None:
     readers = {}
     for i, kind in enumerate(["fold", "obj", "stl_ascii", "stl_binary", "hinges", "result"]):
         t = time.perf_counter()
-        readers[kind] = fuzz_reader(kind, bases, args.reader_cases, args.seed + i,
-                                    args.case_seconds)
+        readers[kind] = fuzz_reader(kind, bases, reader_cases, args.seed + i, args.case_seconds)
         readers[kind]["seconds"] = round(time.perf_counter() - t, 1)
         print(kind, {k: v for k, v in readers[kind].items() if k != "first_messages"},
               flush=True)
     cli = {}
     for i, kind in enumerate(["simulate_fold", "simulate_obj", "render", "export"]):
         t = time.perf_counter()
-        cli[kind] = fuzz_cli(kind, bases, args.cli_cases, args.seed + 100 + i,
-                             args.process_seconds)
+        cli[kind] = fuzz_cli(kind, bases, cli_cases, args.seed + 100 + i, args.process_seconds)
         cli[kind]["seconds"] = round(time.perf_counter() - t, 1)
         print(kind, {k: v for k, v in cli[kind].items() if k != "first_messages"}, flush=True)
-    data = {"meta": {**machine_meta(), "seed": args.seed, "case_seconds": args.case_seconds,
+    data = {"meta": {**_meta.machine(), "seed": args.seed, "case_seconds": args.case_seconds,
                      "process_seconds": args.process_seconds,
                      "seconds": round(time.perf_counter() - start, 1)},
             "readers": readers, "cli": cli}
-    Path(args.out).write_text(json.dumps(data, indent=1))
-    print("wrote", args.out)
+    if out is not None:
+        out.parent.mkdir(parents=True, exist_ok=True)
+        out.write_text(json.dumps(data, indent=1))
+        print("wrote", out)
+    bad = failures(data)
+    print(f"{bad} broken promises")
+    return 1 if bad else 0
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

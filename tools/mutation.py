@@ -1,4 +1,4 @@
-"""Mutation run: do the fast tests catch hand-written bugs in kernels and readers?
+"""Mutation run: do the fast tests catch hand-written bugs in kernels and readers? (a dev tool)
 
 Each mutant replaces one exact snippet of one source file (the snippet must occur
 once) in a *temporary copy* of ``src/`` and ``tests/`` — never the working tree —
@@ -12,9 +12,13 @@ arithmetic). The others run compiled: the copy keeps ``__pycache__``, and numba'
 cache (keyed on each file's content) stays valid for the files not mutated. An
 unmutated baseline of every subset must pass first.
 
-Writes ``bench/results/mutation.json``. Usage::
+Writes ``tools/results/mutation.json`` (~10 min on 2 cores). Usage::
 
-    PYTHONPATH=src python bench/mutation.py [--only ID,ID --out FILE]
+    python tools/mutation.py [--only ID,ID --out FILE]
+    python tools/mutation.py --check   # every snippet still found once (after a refactor)
+
+A mutant whose file no longer holds its snippet is applied to the one file of
+src/ that holds it once (a refactor moved the code); ``--check`` lists those.
 """
 from __future__ import annotations
 
@@ -31,7 +35,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-OUT = ROOT / "bench" / "results" / "mutation.json"
+OUT = ROOT / "tools" / "results" / "mutation.json"
 TIMEOUT_S = 300
 
 SUBSETS = {  # name: (test files, run kernels as plain Python)
@@ -139,6 +143,19 @@ MUTANTS = [
 ]
 
 
+def locate(root: Path, mutant: Mutant) -> tuple[str | None, int]:
+    """The file under ``root`` holding ``mutant``'s snippet exactly once: its own
+    ``file``, else the one file of src/ that does (a refactor moved it); and how many
+    times the snippet occurs in the named file."""
+    named = root / mutant.file
+    count = named.read_text().count(mutant.original) if named.exists() else 0
+    if count == 1:
+        return mutant.file, count
+    found = [p for p in sorted((root / "src").rglob("*.py"))
+             if p.read_text().count(mutant.original) == 1]
+    return (str(found[0].relative_to(root)) if len(found) == 1 else None), count
+
+
 def make_copy(mutant: Mutant | None) -> Path:
     """Temporary root holding src/ (with its __pycache__), tests/, examples/ (the
     element tests register its plugin) and pyproject.toml, ``mutant`` applied."""
@@ -148,13 +165,13 @@ def make_copy(mutant: Mutant | None) -> Path:
     shutil.copytree(ROOT / "examples", root / "examples")
     shutil.copy(ROOT / "pyproject.toml", root)
     if mutant is not None:
-        path = root / mutant.file
-        text = path.read_text()
-        if text.count(mutant.original) != 1:
+        where, count = locate(root, mutant)
+        if where is None:
             shutil.rmtree(root)
-            raise SystemExit(f"mutant {mutant.id}: snippet found {text.count(mutant.original)} "
-                             f"times in {mutant.file} (needs exactly 1)")
-        path.write_text(text.replace(mutant.original, mutant.replacement))
+            raise SystemExit(f"mutant {mutant.id}: snippet found {count} times in "
+                             f"{mutant.file} and in no other one file of src/ (needs exactly 1)")
+        path = root / where
+        path.write_text(path.read_text().replace(mutant.original, mutant.replacement))
     return root
 
 
@@ -195,11 +212,21 @@ def main(argv=None) -> int:
     parser.add_argument("--only", help="comma-separated mutant ids")
     parser.add_argument("--out", type=Path, default=OUT,
                         help="JSON written (with --only: only when given)")
+    parser.add_argument("--check", action="store_true",
+                        help="only check that every mutant's snippet occurs once in its file")
     args = parser.parse_args(argv)
     mutants = MUTANTS
     if args.only:
         wanted = set(args.only.split(","))
         mutants = [m for m in MUTANTS if m.id in wanted]
+    if args.check:
+        where = {m.id: locate(ROOT, m) for m in mutants}
+        stale = [f"{m.id}: {where[m.id][1]} times in {m.file}, in no other one file"
+                 for m in mutants if where[m.id][0] is None]
+        moved = [f"{m.id}: {m.file} -> {where[m.id][0]}" for m in mutants
+                 if where[m.id][0] not in (None, m.file)]
+        print("\n".join(stale + moved) or f"all {len(mutants)} snippets found once")
+        return 1 if stale else 0
     load = [os.getloadavg()[0]]
     start = time.perf_counter()
     baseline = {}
@@ -222,12 +249,12 @@ def main(argv=None) -> int:
     if args.only and args.out == OUT:
         return 0
     sys.path.insert(0, str(ROOT / "bench"))
-    from _meta import machine_meta
+    import _meta
 
     commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, text=True,
                             capture_output=True, check=False).stdout.strip()
     args.out.write_text(json.dumps({
-        "meta": {**machine_meta(), "date": time.strftime("%Y-%m-%d"), "commit": commit,
+        "meta": {**_meta.machine(), "commit": commit,
                  "load_average_1min": load, "timeout_s": TIMEOUT_S,
                  "total_seconds": round(time.perf_counter() - start, 1),
                  "subsets": {k: {"tests": v[0], "numba_disable_jit": v[1]}
