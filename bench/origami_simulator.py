@@ -27,7 +27,7 @@ same run*. This benchmark runs both, interleaved, ``ROUNDS`` rounds:
 * **foldcore**: the same layout (Miura 12 × 13, a = b = 80 mm, γ = 84°;
   H = 0.01a, arc hinges of Eq. 7's width W = πH/2 graded along each straight
   line by ``patterns.miura_flat_widths`` — the widths that let a thick Miura
-  fold flat: docs/design.md#a-thick-miura-has-no-flat-state-with-equal-hinges
+  fold flat: docs/architecture.md#a-thick-miura-has-no-flat-state-with-equal-hinges
   — every crease driven to its rigid-fold angle at facet tilt 90°, default
   strategy, tolerance 1e-9), warm numba cache, one warm-up fold in this
   process first; ``seconds`` is ``Simulation(...).run()`` (the mesh is built

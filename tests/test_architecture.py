@@ -162,7 +162,8 @@ LAYERS = [
     ("foldcore.cli", "foldcore.demo", "foldcore.warmup", "foldcore.__main__"),
     ("foldcore.job", "foldcore.scenes"),
     ("foldcore.animate", "foldcore.view", "foldcore.outputs", "foldcore.render",
-     "foldcore.fabrication", "foldcore.destinations", "foldcore.files"),
+     "foldcore.fabrication", "foldcore.destinations", "foldcore.result_file",
+     "foldcore.surface"),
     ("foldcore.simulation", "foldcore.result"),
     ("foldcore.strategies",),
     ("foldcore.convergence", "foldcore.probe"),
@@ -171,7 +172,7 @@ LAYERS = [
     ("foldcore.thickening", "foldcore.io", "foldcore.pattern", "foldcore.mesh",
      "foldcore.measure", "foldcore.strain", "foldcore.patterns", "foldcore.planar",
      "foldcore.kinematics", "foldcore.limits", "foldcore.hinges", "foldcore.actuation",
-     "foldcore.errors", "elements"),
+     "foldcore.errors", "foldcore.files", "elements"),
 ]
 
 

@@ -38,7 +38,7 @@ def test_mv_without_angles_fold_to_180_as_in_origami_simulator():
     np.testing.assert_array_equal(pattern.fold_angles[8:], [180.0, 180.0, 180.0, -180.0])
     assert np.isnan(pattern.fold_angles[:8]).all()  # boundary
     (message,) = said
-    assert "f.fold" in message and "4 M/V creases" in message and "--mv-passive" in message
+    assert "f.fold" in message and "4 M/V creases" in message and "reading.mv_without_angle='passive'" in message
 
 
 def test_an_assigned_crease_folds_to_its_own_largest_angle_below_180():
@@ -133,7 +133,7 @@ def test_an_angle_against_its_assignment_is_refused_or_trusted():
     d["edges_foldAngle"][6] = -90.0  # a V crease at -90: Rabbit Ear's kite writes M +90
     with pytest.raises(PatternError) as info:
         pattern_from_fold_dict(d, "k.fold")
-    assert "edge 6" in str(info.value) and "--trust-assignment" in str(info.value)
+    assert "edge 6" in str(info.value) and "reading.trust_assignment=True" in str(info.value)
     pattern, said = read_said(d, Reading(trust_assignment=True))
     assert pattern.fold_angles[6] == 90.0
     assert any("1 fold angles took their assignment's sign" in m for m in said)

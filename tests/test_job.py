@@ -230,6 +230,6 @@ def test_a_crease_folded_to_the_other_side_is_counted_and_said():
         assert actuation_entries(result, pattern)["wrong_side"] == wrong
         _, said = run_summary(result, pattern, "hinge.fold", 100)
         assert len(said) == 1 and ("1 folded to the other side" in said[0]) == bool(wrong)
-        assert "--elastic-cells lets the panels bend" in said[0]
+        assert "thickening.elastic_cells lets the panels bend" in said[0]
     _, said = run_summary(result, pattern, "hinge.fold", 100, elastic=True)
-    assert "with elastic panels" in said[0] and "--elastic-cells" not in said[0]
+    assert "with elastic panels" in said[0] and "elastic_cells" not in said[0]

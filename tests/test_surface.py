@@ -11,10 +11,9 @@ import numpy as np
 import pytest
 import shapely
 
-from foldcore.errors import FoldcoreError
 from foldcore.mesh import surface_polygons
 from foldcore.pattern import CreasePattern
-from foldcore.surface import (TriangulationError, enclosed_volume, stl_bytes,
+from foldcore.surface import (TriangulationError, enclosed_volume, stl_bytes, write_stl,
                               surface_triangles, triangulate_polygon)
 from foldcore.thickening import thicken
 
@@ -77,7 +76,7 @@ def test_the_stl_of_a_non_convex_panel_is_closed_with_the_prism_volume(tmp_path)
     assert _outside(shapely.Polygon(xy), xy, _fan(len(xy)))   # a fan would get it wrong
     data = stl_bytes(mesh)
     path = tmp_path / "u.stl"
-    mesh.export(path)
+    write_stl(path, mesh)
     assert path.read_bytes() == data                    # one STL writer
     solid = trimesh.load(str(path), file_type="stl", process=True)
     assert solid.is_watertight and solid.is_winding_consistent
@@ -85,13 +84,6 @@ def test_the_stl_of_a_non_convex_panel_is_closed_with_the_prism_volume(tmp_path)
     triangles = surface_triangles(mesh)
     assert enclosed_volume(mesh.rest_positions, triangles) == \
         pytest.approx(mesh.volume(), rel=1e-12)
-
-
-def test_thick_mesh_export_writes_stl_only(tmp_path):
-    mesh = _u_panel_mesh()
-    with pytest.raises(FoldcoreError, match="STL only"):
-        mesh.export(tmp_path / "u.vtu")
-    assert list(tmp_path.iterdir()) == []
 
 
 def test_a_polygon_earcut_cannot_cover_is_refused_naming_the_face_and_the_file():

@@ -27,7 +27,7 @@ Folded solid (3D printing, CAD): binary STL (mm) of the outer surface,
 are read back by :func:`foldcore.result_file.read_result`. Every file is
 written atomically (:mod:`foldcore.files`): it appears complete or not at all.
 The public names of those modules are re-exported here. Design notes:
-``docs/design.md#fabrication-files``.
+``docs/architecture.md#fabrication-files``.
 """
 from __future__ import annotations
 
@@ -264,7 +264,7 @@ def export(result: ResultFile, svg=None, dxf=None, stl=None, stroke_mm: float | 
         SVG stroke width and margin, mm (default: shares of the sheet's extent).
     """
     if not (svg or dxf or stl):
-        raise ExportError("nothing to export: give --svg, --dxf and/or --stl")
+        raise ExportError("nothing to export: give svg, dxf and/or stl paths")
     for path in (svg, dxf, stl):
         if path:
             files.check_folder(path, ExportError)  # every destination before any write

@@ -10,7 +10,7 @@ a kill leaves nothing behind; SIGKILL cannot be caught and may leave a
 ``.NAME.PID.HEX.tmp`` file. :func:`all_or_nothing` extends this to several
 files: none is renamed until every writer has succeeded.
 
-Design notes: ``docs/design.md#output-files-one-module-writes-them-all``.
+Design notes: ``docs/architecture.md#output-files-one-module-writes-them-all``.
 """
 from __future__ import annotations
 

@@ -103,13 +103,13 @@ def check_stiffness(stiffness: dict | None, where: str) -> None:
 
 def check_inputs(pattern, thickness=None, hinge_width=None, stiffness=None) -> None:
     """What ``foldcore simulate`` was given beyond the pattern file's own checks:
-    the sheet's extent, the ``--thickness`` and ``--hinge-width`` options (mm)
+    the sheet's extent, the ``thickening.thickness`` and ``thickening.hinge_width`` options (mm)
     and the file's stiffness factors; PatternError naming the file and option."""
     source = pattern.source
     if thickness is not None or hinge_width is not None:
         check_extent(sheet_extent(pattern.vertices), source)
     if thickness is not None:
-        check_thickness(thickness, pattern.vertices, "--thickness", source)
+        check_thickness(thickness, pattern.vertices, "thickening.thickness", source)
     if hinge_width is not None:
-        check_width(hinge_width, pattern.vertices, "--hinge-width", source)
+        check_width(hinge_width, pattern.vertices, "thickening.hinge_width", source)
     check_stiffness(stiffness, source)

@@ -169,34 +169,6 @@ class ThickMesh:
                     kinds.append(name)
         return faces, kinds
 
-    def to_pyvista(self, positions: np.ndarray | None = None):
-        """The outer surface as a ``pyvista.PolyData`` of triangles at ``positions`` (N, 3)
-        mm (default: rest), with cell data ``is_hinge``, ``strip``, ``edge``, ``bending``
-        (:func:`foldcore.render.surface_polydata`; needs the ``render`` extra)."""
-        from .render import surface_polydata
-
-        return surface_polydata(self, positions)
-
-    def export(self, path, positions: np.ndarray | None = None) -> None:
-        """Write the outer surface at ``positions`` (N, 3) mm (default: rest) as binary
-        STL (mm), atomically (:func:`foldcore.surface.write_stl`).
-
-        Raises
-        ------
-        ExportError
-            ``path`` does not end in ``.stl`` (other formats:
-            ``mesh.to_pyvista(positions).save(path)``), or as ``write_stl``.
-        """
-        import os
-
-        from .surface import ExportError, write_stl
-
-        if os.path.splitext(os.fspath(path))[1].lower() != ".stl":
-            raise ExportError(f"{os.fspath(path)}: ThickMesh.export writes binary STL only "
-                              "(name the file .stl); for other formats use "
-                              "mesh.to_pyvista(positions).save(path)")
-        write_stl(path, self, positions)
-
 
 def surface_faces(mesh: ThickMesh) -> list:
     """Outer surface of the prism mesh: prism faces not shared by two prisms."""

@@ -98,7 +98,7 @@ def run_summary(result, pattern, source: str, fold_percent: float,
     if not driven:
         warns.append(f"{source}: no crease is driven (no target angles): the sheet stays "
                      "as it is; give edges_foldAngle, or M/V creases without angles "
-                     "(and no --mv-passive)")
+                     "(and not reading.mv_without_angle='passive')")
     elif entries["binding"]:
         missed, wrong = entries["missed"], entries["wrong_side"]
         warns.append(f"{source}: converged, but {missed} of {driven} driven creases miss "
@@ -108,9 +108,9 @@ def run_summary(result, pattern, source: str, fold_percent: float,
                      + ("(with elastic panels: meeting them needs the faces to stretch, or "
                         "hinge stiffness factors above the panels')" if elastic else
                         "(with rigid panels: a pattern that is not rigidly foldable; "
-                        "--elastic-cells lets the panels bend)")
-                     + "; the report's actuation lists each crease (README: Files made "
-                     "for Origami Simulator)")
+                        "thickening.elastic_cells lets the panels bend)")
+                     + "; the report's actuation lists each crease "
+                     "(docs/guide/strategies.md#reached-or-binding)")
     return line, warns
 
 

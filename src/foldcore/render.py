@@ -199,8 +199,8 @@ def strip_bend_angles(mesh, positions) -> np.ndarray:
 def surface_polydata(mesh, positions=None, hinges: bool | None = None):
     """The outer surface of ``mesh`` as a ``pyvista.PolyData`` of triangles.
 
-    The one mesh-to-PyVista conversion: the renders draw it, and
-    :meth:`foldcore.mesh.ThickMesh.to_pyvista` returns it. Faces are
+    The one mesh-to-PyVista conversion: the renders, animations and the viewer
+    draw it (``.save(path)`` writes any format PyVista knows). Faces are
     triangulated on the flat footprint (:func:`foldcore.surface.surface_triangles`,
     no slivers at the collinear points panels share with strips).
 

@@ -63,7 +63,7 @@ class ResultFile:
             raise PatternError(
                 f"{self.source}: the panels of the folded frame do not fit the flat sheet "
                 f"rebuilt with the file's hinge widths (misfit {self.footprint_misfit_mm:.3g} mm "
-                f"> {limit:.3g} mm); pass the --hinge-width used with simulate")
+                f"> {limit:.3g} mm); pass the thickening.hinge_width used with simulate")
 
 
 def read_result(path, hinge_width=None, subdivisions=None) -> ResultFile:
@@ -105,7 +105,7 @@ def read_result(path, hinge_width=None, subdivisions=None) -> ResultFile:
         raise PatternError(f"{source}: no foldcore:thickness; not a foldcore result file")
     _check_reach(positions, fold.pattern, fold.thickness, source)
     if hinge_width is not None:
-        limits.check_width(hinge_width, fold.pattern.vertices, "--hinge-width", source)
+        limits.check_width(hinge_width, fold.pattern.vertices, "thickening.hinge_width", source)
     recipe = {"elastic": faces_cells(d, len(fold.pattern.faces), source) or None,
               "stretch": edges_poisson(d, fold.pattern.n_edges, source) or None,
               "hinge": fold.hinge}
@@ -229,5 +229,5 @@ def _matching_mesh(pattern, thickness, hinge_width, subdivisions, positions, fac
                                else f"auto and 1..{MAX_SUBDIVISIONS}")
     raise PatternError(f"{source}: the folded frame ({len(positions)} vertices, {len(faces)} "
                        f"faces) matches no thick mesh rebuilt from the file (thickness "
-                       f"{thickness:g} mm, {tried}); pass the --subdivisions and "
-                       "--hinge-width used with simulate")
+                       f"{thickness:g} mm, {tried}); pass the thickening.subdivisions "
+                       "and thickening.hinge_width used with simulate")

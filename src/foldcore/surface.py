@@ -11,7 +11,7 @@ file and the scenes' volumes all use :func:`surface_triangles`.
 
 STL: binary, mm, written with NumPy (a 50-byte record per triangle,
 :data:`foldcore.io.obj.STL_RECORD`) and atomically (:mod:`foldcore.files`).
-Design notes: ``docs/design.md#triangulating-the-outer-surface``.
+Design notes: ``docs/architecture.md#triangulating-the-outer-surface``.
 """
 from __future__ import annotations
 

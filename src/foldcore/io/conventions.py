@@ -104,7 +104,7 @@ def assigned_angles(assignments, source: str, reading: Reading,
     if not mv:
         return None
     note(source, f"no edges_foldAngle: {mv} M/V creases fold to ±180° × the fold percent "
-                 "(Origami Simulator's convention; --mv-passive keeps them passive)")
+                 "(Origami Simulator's convention; reading.mv_without_angle='passive' keeps them passive)")
     limits = [None] * len(assignments) if max_angles is None else max_angles
     return [None if a not in ASSIGNED_ANGLE else
             ASSIGNED_ANGLE[a] * min(180.0, 180.0 if m is None else m) / 180.0
@@ -121,7 +121,7 @@ def trust_signs(angles: list, assignments, source: str) -> list:
             flipped += 1
     if flipped:
         note(source, f"{flipped} fold angles took their assignment's sign "
-                     "(--trust-assignment)")
+                     "(reading.trust_assignment=True)")
     return out
 
 

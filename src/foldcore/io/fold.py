@@ -46,7 +46,7 @@ offending item; files above :data:`MAX_FILE_BYTES` are refused unread.
 Large files: arrays of plain numbers, ids and letters are checked with NumPy;
 from the first item that may be bad on, the row-by-row checks run, so the
 message names the same item (memory and time:
-``docs/design.md#reading-large-fold-files``).
+``docs/architecture.md#reading-large-fold-files``).
 """
 from __future__ import annotations
 
@@ -520,8 +520,8 @@ def build_pattern(args: dict) -> CreasePattern:
         return CreasePattern(**args)
     except PatternError as exc:
         if "contradicts assignment" in str(exc):  # a file writing magnitudes only
-            raise PatternError(f"{exc}; --trust-assignment (Reading(trust_assignment="
-                               "True)) gives angles their assignment's sign") from None
+            raise PatternError(f"{exc}; reading.trust_assignment=True gives angles their "
+                               "assignment's sign") from None
         raise
     except Exception as exc:  # last resort: never a raw traceback for user input
         raise PatternError(f"{args['source']}: unexpected malformed pattern "
