@@ -23,3 +23,15 @@ def runs():
     from foldcore import scenes
 
     return {name: scenes.run(name, quick=True) for name in scenes.NAMES}
+
+
+@pytest.fixture
+def hinge_file(tmp_path):
+    """A FOLD file of one 90° valley hinge (panels 5 × 2 mm, W = 2 mm, H = 1 mm)."""
+    from foldcore import patterns
+    from foldcore.io import write_fold
+
+    pattern = patterns.single_hinge(panel_length=5.0, depth=2.0, angle=90.0, width=2.0)
+    path = tmp_path / "hinge.fold"
+    write_fold(path, pattern, thickness=1.0)
+    return path

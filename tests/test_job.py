@@ -12,20 +12,12 @@ import pytest
 import foldcore
 from foldcore import cli, patterns
 from foldcore.errors import RunWarning
-from foldcore.io import write_fold
 from foldcore.job import Interrupted
 from foldcore.options import OptionError
 from foldcore.simulation import Simulation
 
 REAL = "tests/data/real/"
 
-
-@pytest.fixture
-def hinge_file(tmp_path):
-    pattern = patterns.single_hinge(panel_length=5.0, depth=2.0, angle=90.0, width=2.0)
-    path = tmp_path / "hinge.fold"
-    write_fold(path, pattern, thickness=1.0)
-    return path
 
 
 def test_simulate_is_the_command_line_as_a_call(hinge_file, tmp_path):

@@ -4,19 +4,8 @@ from __future__ import annotations
 
 import logging
 
-import pytest
-
 from foldcore import cli, patterns, thicken
-from foldcore.io import write_fold
 from foldcore.simulation import Simulation
-
-
-@pytest.fixture
-def hinge_file(tmp_path):
-    pattern = patterns.single_hinge(panel_length=5.0, depth=2.0, angle=90.0, width=2.0)
-    path = tmp_path / "hinge.fold"
-    write_fold(path, pattern, thickness=1.0)
-    return path
 
 
 def test_the_library_says_nothing_unless_asked(hinge_file, capsys):
