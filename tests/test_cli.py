@@ -1,4 +1,4 @@
-"""``foldcore simulate``: the contract of DESIGN.md (report, FOLD output, exit codes).
+"""``foldcore simulate``: its contract (report, FOLD output, exit codes, one-line refusals).
 
 Runs in-process through ``foldcore.cli.main`` for speed; one test runs the
 installed console script to check the real exit code and the absence of a
@@ -72,8 +72,10 @@ def test_not_converging_is_a_result_with_a_warning(fold_file, tmp_path, capsys):
 
 
 def test_a_stalled_run_says_so_in_the_report_and_on_stderr(tmp_path, capsys):
-    """Issue 18's reproducer through the CLI: a hinge at thickness / size = 1e-4 under
-    lbfgs stopped "converged" after 2 iterations, 90° short."""
+    """A small step is not a verdict, through the CLI: a hinge at thickness / size =
+    1e-4 under lbfgs takes steps far below the tolerance 90° short of its target
+    (a step-length rule called it converged after 2 iterations;
+    docs/architecture.md#a-small-step-is-not-a-verdict)."""
     pattern = patterns.single_hinge(panel_length=10.0, depth=10.0, angle=TARGET)
     path, report = tmp_path / "thin.fold", tmp_path / "r.json"
     write_fold(path, pattern, thickness=0.002)
@@ -285,8 +287,8 @@ def test_a_signal_during_the_writes_leaves_no_file(fold_file, tmp_path, capsys,
 
 
 def test_version_and_a_render_that_is_not_png(fold_file, tmp_path, capsys):
-    """Issue 19's small ones: `--version` exists; `--render out.jpg` wrote PNG bytes
-    under a .jpg name — now refused before the run."""
+    """`--version` exists; `--render out.jpg` (a PNG render under a .jpg name) is
+    refused before the run."""
     assert main(["--version"]) == 0
     assert capsys.readouterr().out.strip().startswith("foldcore 0.")
     assert main(["simulate", str(fold_file), "--render", str(tmp_path / "out.jpg")]) == 2

@@ -52,3 +52,53 @@ def test_a_new_element_type_is_one_new_file(tmp_path):
     # a 30 mm strut between edges 2 × 19 mm from the hinge: cos(φ/2) ≈ 30 / 38 (+ the
     # hinge's own chord, − H sin(φ/2)), φ ≈ 80°, far short of the 90° target
     assert reason == "converged" and 75.0 < float(angle) < 85.0
+
+
+LINKED = ("src", "tests", "docs", "examples", "README.md", "CHANGELOG.md")
+
+
+def slug(heading: str) -> str:
+    """GitHub's anchor of a heading: lowercase, stripped, only letters, digits,
+    spaces and hyphens kept, spaces to hyphens."""
+    kept = "".join(c for c in heading.strip().lower() if c.isalnum() or c in " -")
+    return kept.replace(" ", "-")
+
+
+def text_files():
+    for name in LINKED:
+        path = ROOT / name
+        files = [path] if path.is_file() else sorted(path.rglob("*"))
+        for file in files:
+            if file.is_file() and "__pycache__" not in file.parts:
+                try:
+                    yield file, file.read_text()
+                except UnicodeDecodeError:  # binary (images, caches)
+                    continue
+
+
+def test_every_architecture_anchor_is_a_heading_of_the_page():
+    """Code and docs link design notes by the page's name and a heading's anchor:
+    each anchor is a heading of docs/architecture.md (outside code blocks), so no
+    link dangles after a heading is renamed."""
+    page = re.sub(r"```.*?```", "", (ROOT / "docs" / "architecture.md").read_text(),
+                  flags=re.S)
+    headings = {slug(line.lstrip("#")) for line in page.splitlines()
+                if re.match(r"#{1,6} ", line)}
+    missing = sorted({f"{file.relative_to(ROOT)}: #{anchor}"
+                      for file, text in text_files()
+                      for anchor in re.findall(r"architecture\.md#([a-z0-9-]*)", text)
+                      if anchor not in headings})
+    assert not missing, "\n".join(missing)
+
+
+def test_every_relative_link_of_the_docs_points_at_a_file():
+    """Relative markdown links of docs/ and README.md name files that exist."""
+    pages = [ROOT / "README.md", *sorted((ROOT / "docs").rglob("*.md"))]
+    broken = []
+    for page in pages:
+        for target in re.findall(r"\]\(([^)\s]+)\)", page.read_text()):
+            if re.match(r"[a-z]+:|#", target):  # a URL, or an anchor of the page itself
+                continue
+            if not (page.parent / target.split("#")[0]).exists():
+                broken.append(f"{page.relative_to(ROOT)}: {target}")
+    assert not broken, "\n".join(broken)

@@ -314,7 +314,7 @@ def _bad_export_inputs(result_fold, tmp_path):
     short = tmp_path / "short.fold"
     short.write_text(json.dumps(edited))
     data = json.loads(result_fold.read_text())
-    del data["foldcore:thickness"]  # survived bench/mutation.py's run as "no-thickness"
+    del data["foldcore:thickness"]  # kills tools/mutation.py's "no-thickness" mutant
     no_thickness = tmp_path / "no_thickness.fold"
     no_thickness.write_text(json.dumps(data))
     variants = {}

@@ -11,7 +11,8 @@ Bounds: a compatible flat state is reached to the run's tolerance, 1e-8 ×
 size; over a hinge of width W ≥ 0.785 mm that is a fold angle within
 2 × 1e-8 × 100 mm / W ≈ 1.5e-4°, so 1e-3° per crease. The incompatible ones
 must miss by more than 1° on their straight creases (measured 2.5–6°; the
-singular flat state amplifies the miss on them, :mod:`bench/os_miura.py`).
+singular flat state amplifies the miss on them:
+docs/architecture.md#a-thick-miura-has-no-flat-state-with-equal-hinges).
 """
 from __future__ import annotations
 

@@ -1,7 +1,7 @@
-"""A fold-percent path continues from converged states (issue 17, item 3): one
-rigid-body engine serves every run and each frame starts from the extrapolation
-of the previous two, so a fine path costs few steps per frame and ends where a
-single fold does."""
+"""A fold-percent path continues from converged states: one rigid-body engine
+serves every run and each frame starts from the extrapolation of the previous
+two, so a fine path costs few steps per frame and ends where a single fold does
+(docs/architecture.md#paths-one-engine-and-a-predictor)."""
 from __future__ import annotations
 
 import numpy as np
@@ -78,8 +78,8 @@ def test_a_sweep_from_flat_selects_its_branch_once():
 def test_a_frame_ends_on_its_simplified_correction_within_the_bound_it_states():
     """After a frame's first step the simplified correction (the step's factorisation
     applied to the new residual) contracts by Θ ≪ 1 and ends the frame: a thin
-    Miura 8 × 8 in 0.5 % frames took 3 steps a frame, then 2 (on Θ from two steps),
-    now 1 (rigid_body.RigidBodySolver.distance_left). The distance it states is a
+    Miura 8 × 8 in 0.5 % frames takes 1 step a frame (3 on the step's length alone,
+    2 on Θ from two steps; StoppingRule.distance_left). The distance it states is a
     bound: a run continued to a tighter tolerance moves less (measured 5.0e-11 ×
     the size against a stated 7.0e-10)."""
     pattern = patterns.miura_one_crease(8, 8, a=20.0, b=20.0, width=0.06)

@@ -2,7 +2,7 @@
 
 Tolerances: a single actuated hinge is a compatible target (a zero-energy
 state exists), so the fold-angle error is bounded by the stopping rule
-(step ≤ 1e-10 × extent); 0.01° is the accuracy the issue asks for. The
+(step ≤ 1e-10 × extent); 0.01° is the accuracy asked of every fold. The
 iteration bound (50) is the algorithm's property being tested — the paper's
 map needs > 10⁴ iterations on these scenes. The Jacobian check
 uses a forward difference with ε = 1e-6 (truncation O(ε) relative).

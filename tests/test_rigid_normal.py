@@ -1,6 +1,7 @@
-"""The rigid-body step's normal equations assembled strip by strip (strategies/rigid/normal.py)
-equal the ones of the sparse Jacobian it replaces: JᵀJ, Jᵀr, J·v and Jᵀu, with and
-without position targets and M/V side rows acting, to rounding."""
+"""The rigid-body step's normal equations assembled strip by strip
+(strategies/rigid/normal.py) equal the ones of the sparse Jacobian
+(tests/rigid_reference.py): JᵀJ, Jᵀr, J·v and Jᵀu, with and without position
+targets and M/V side rows acting, to rounding."""
 from __future__ import annotations
 
 import numpy as np

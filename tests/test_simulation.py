@@ -56,7 +56,7 @@ def test_energy_never_increases_with_fixed_targets():
     result = Simulation(mesh, pattern).run(tolerance=0, max_iterations=2000)
     energy = result.energy
     assert np.all(np.diff(energy) <= 1e-12 * energy[0])
-    assert energy[-1] < 0.1 * energy[0]  # and it does decrease (slowly: DESIGN.md)
+    assert energy[-1] < 0.1 * energy[0]  # and it does decrease
 
 
 def test_rigid_panels_keep_their_edge_lengths():

@@ -6,7 +6,7 @@ the strain matches the closed form to 1e-6 relative (the Eq. 9 estimate
 inverts the target exactly); Eq. 8 see the test. Fracture: the paper's map
 folds the strips gradually (45° in 730 iterations, 0.06° per iteration on
 average, measured), so the first failing iteration's angle lies within about
-one step of the closed-form failure angle; 0.1° is the issue's bound.
+one step of the closed-form failure angle; 0.1° is the bound asked of it.
 """
 from __future__ import annotations
 

@@ -90,8 +90,8 @@ def test_hybrid_on_elastic_rings_starts_rigid_and_finishes_with_newton():
     crease at ±9.08°, E = 0.833 mm⁵, 2.7× the minima). Which minimum a run reaches is
     decided by rounding off that saddle, so the check is against Newton's minimum
     under the symmetry: the same E to rounding and the same angles within 1e-6°.
-    L-BFGS does not get lower (on an AMD EPYC host it stalls on the saddle after
-    40 000 iterations). The stretch hinge is refused by name."""
+    L-BFGS does not get lower (it can stall on the saddle: 40 000 iterations
+    there on one machine). The stretch hinge is refused by name."""
     pattern, mesh = rings_waterbomb(5.0)
     sim = Simulation(mesh, pattern, solver="hybrid")
     phases = []
@@ -120,8 +120,8 @@ def test_hybrid_on_elastic_rings_starts_rigid_and_finishes_with_newton():
 
 def test_newton_at_met_targets_settles_on_rounding():
     """Every target met where the run starts (fold percent 0, at rest): E is at
-    rounding level, no step can lower it, and the run settles (before the energy
-    floor, each step rejected 17 factorisations and the run took its budget)."""
+    rounding level, no step can lower it, and the run settles (without the energy
+    floor each step rejected 17 factorisations and the run took its budget)."""
     pattern, mesh = rings_waterbomb(10.0)
     sim = Simulation(mesh, pattern, solver="newton")
     sim.set_fold_percent(0.0)

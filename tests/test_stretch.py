@@ -4,7 +4,7 @@ Tolerances: between rigid panels the width is free (the panels just move
 apart) but the panels' edges hold the strip's length, so its length ratio
 lies between λ^(−ν) and 1; with panels 10⁶ times softer than volume-weighted
 the strip is as good as isolated, its target is reachable, and it reaches
-width λ and length λ^(−ν) to 1e-3 (the issue's bound).
+width λ and length λ^(−ν) to 1e-3 (the bound asked of it).
 """
 from __future__ import annotations
 

@@ -1,11 +1,12 @@
-"""`converged` means the fold was reached (issue 18's first item): a stall of small
-steps is not a verdict, for the rigid-body strategies (their own test) and the
-local/global ones (the equilibrium probe, :mod:`foldcore.probe`).
+"""`converged` means the fold was reached: a stall of small steps is not a verdict,
+for the rigid-body strategies (their own test) and the local/global ones (the
+equilibrium probe, :mod:`foldcore.probe`;
+docs/architecture.md#a-small-step-is-not-a-verdict).
 
-Reproducer: a thin Miura from flat, one crease driven. Its hinges are so stiff
+Scene: a thin Miura from flat, one crease driven. Its hinges are so stiff
 against the sheet's size that Levenberg–Marquardt leaves the flat state in steps
 far below tolerance × size while still lowering the energy by percents per step;
-the length-only rule stopped there "converged" 59.8° (H = 1e-4 a) and 60° (H =
+a length-only rule stops there "converged" 59.8° (H = 1e-4 a) and 60° (H =
 1e-5 a, after 3 iterations) short of the rigid-origami closed form.
 """
 from __future__ import annotations
@@ -64,11 +65,11 @@ def hinge_to_90(h_over_size: float):
 @pytest.mark.parametrize("solver", ["paper", "lbfgs", "anderson"])
 @pytest.mark.parametrize("h_over_size", [1e-3, 1e-4])
 def test_a_local_global_stall_is_not_converged(solver, h_over_size):
-    """The issue's reproducer: these strategies' steps fall below 1e-8 × size within a
-    few iterations while the hinge is still ≈ 90° short (the length-only rule said
-    "converged" after 2 iterations). Now: not converged, ``stalled``, with a residual
-    above the tolerance; the plain map stops as soon as its rate shows the budget
-    cannot reach the fold."""
+    """These strategies' steps fall below 1e-8 × size within a few iterations while
+    the hinge is still ≈ 90° short (a length-only rule says "converged" after 2
+    iterations): not converged, ``stalled``, with a residual above the tolerance;
+    the plain map stops as soon as its rate shows the budget cannot reach the
+    fold."""
     pattern, mesh = hinge_to_90(h_over_size)
     result = Simulation(mesh, pattern, solver=solver).run(tolerance=1e-8, max_iterations=400)
     assert result.fold_angles_deg[0] < 80.0  # far from the fold: the verdict must say so
@@ -136,8 +137,8 @@ def test_every_strategy_gives_the_same_verdict_in_mm_m_and_um(solver):
     """The same scene in mm, m and µm, tolerance 1e-12: converged in every unit, angles
     equal to 1e-9 relative (measured ≤ 1.1e-12 rigid/hybrid on the waterbomb; the
     hinge ≤ 8e-13 under paper, lbfgs and anderson — paper after 3 421 iterations in each
-    unit). Before the hold ignored rounding-sized drift, paper was ``converged`` in mm
-    and ``stalled`` in m and µm at the same iteration."""
+    unit). A hold that extrapolated rounding-sized drift made paper ``converged`` in
+    mm and ``stalled`` in m and µm at the same iteration."""
     scene, budget = UNIT_CASES[solver]
     runs = []
     for scale in (1.0, 1e-3, 1e3):
@@ -189,10 +190,10 @@ def test_a_power_of_two_unit_gives_the_same_run_bit_for_bit(solver):
 
 def test_lbfgs_converges_on_the_waterbomb_in_mm_m_and_um():
     """The released stage of a fold from flat starts where the branch stage settled:
-    at the rounding floor, its energy cannot fall to half the stage's start, and in
-    m the run was ``stalled`` after 20 000 iterations with an estimated distance of
-    2e-13 × size. Now the energy is measured from the run's start: converged in every
-    unit. Each run is within tolerance × size of an equilibrium, so two runs' fold
+    at the rounding floor, its energy cannot fall to half the stage's start (in m,
+    measured from the stage's start, the run ended ``stalled`` after 20 000
+    iterations 2e-13 × size away). Measured from the run's start: converged in
+    every unit. Each run is within tolerance × size of an equilibrium, so two runs' fold
     angles differ by at most 2 × tolerance × size / H radians (measured 8.3e-7 rad
     of the 2e-6 allowed: the tolerance, not the verdict, limits the agreement)."""
     tolerance, angles = 1e-8, []
@@ -210,8 +211,9 @@ def test_lbfgs_converges_on_the_waterbomb_in_mm_m_and_um():
 @pytest.mark.parametrize("solver", ["paper", "lbfgs", "anderson", "hybrid"])
 def test_a_run_from_its_own_equilibrium_converges_at_once(solver):
     """Run again with the same targets: the second run starts at the equilibrium, at
-    the rounding floor; ``paper`` called it ``stalled`` (its energy had not fallen
-    within the run) before the energy was measured from the targets' last change."""
+    the rounding floor; its energy does not fall within the run, so the probe
+    measures it from the targets' last change (from the run's start, ``paper``
+    would call it ``stalled``)."""
     pattern, mesh = scaled("hinge", 1.0)
     sim = Simulation(mesh, pattern, solver=solver)
     first = sim.run(tolerance=1e-10, max_iterations=20_000)
@@ -229,7 +231,7 @@ def test_a_converged_binding_fold_is_within_the_tolerance_of_its_equilibrium():
     (J₀ᵀ r(x₀ + v) ≈ 0): the simplified correction measured with it stopped the
     run after 92 iterations 2.2e-3 mm from the equilibrium, 18 000 × the limit;
     and E's rounding noise hides the last steps' decrease (rejected steps
-    stopped a run 8 × the limit away, RigidBodySolver._closer_within_rounding).
+    stopped a run 8 × the limit away, LevenbergMarquardt.closer_within_rounding).
     Converged at tolerance 1e-9, the positions must be within the distance two
     runs each within tolerance × size of the equilibrium can be apart (1.01 ×
     the limit; 2 × allowed for the estimate) of the run at 1e-11 (the tightest
@@ -253,7 +255,7 @@ def test_extrapolating_a_binding_tail_keeps_the_equilibrium():
     this sheet). The flat state's equilibria form a valley: at tolerance 1e-13
     both ways end 3e-6 mm (7e-6°) apart at energies equal to 1e-15, so the
     check is the energy (two minima of one valley: equal to rounding, 1e-12)
-    and the angles to 1e-4° (the corpus's "same state"), not the positions."""
+    and the angles to 1e-4°, not the positions."""
     from foldcore.strategies.hybrid import HybridOptions
     from foldcore.strategies.rigid import RigidOptions
 
@@ -280,10 +282,10 @@ def flat_miura6():
 def test_newton_at_its_resolution_ends_stalled_not_at_the_budget():
     """Below the tolerance a binding fold resolves (the thick Miura 6 × 6 flat at
     1e-13: limit 1.2e-11 mm), the rigid phase hands over to ``newton``, whose
-    steps then wander at ~1e-8 mm with E unchanged to rounding; they took the
-    whole 3 000-step budget (23 s). Now the run ends ``stalled`` once
-    ``stall_steps`` accepted steps changed E by no more than rounding, and it is
-    not converged."""
+    steps then wander at ~1e-8 mm with E unchanged to rounding (without the stall
+    test they took the whole 3 000-step budget, 23 s). The run ends ``stalled``
+    once ``stall_steps`` accepted steps changed E by no more than rounding, and it
+    is not converged."""
     from foldcore.strategies import newton
 
     pattern, mesh = flat_miura6()

@@ -13,11 +13,9 @@ Kept free of heavy imports (the command line reads these names).
   creases and the panels give way and the actuated angles are reached.
 
 Where every target can be met (the axis hinge on a rigid-foldable pattern)
-both reach the same state. Why ``"equal"`` is the default (measured,
-bench/accuracy): with the axis hinge both meet the closed forms, while the
-10³ stiffness contrast of ``"angle"`` slows L-BFGS and can stall the
-rigid-body strategy (a thin mode-B vertex, 150/60/30/120, stopped at 12.7°
-of a 60° target under ``rigid``; ``hybrid`` recovered it).
+both reach the same state; ``"equal"`` is the default because the stiffness
+contrast of ``"angle"`` slows L-BFGS and can stall the rigid-body strategy
+(``bench/accuracy.py``; `docs/architecture.md#branch-selection`).
 
 **Branch selection by assignment** (``branch_floor_deg``, ``--branch-floor``):
 the flat state is a bifurcation — a degree-4 vertex has two branches, a
@@ -28,14 +26,9 @@ folds with every passive M/V crease held at least ``BRANCH_FLOOR_DEG`` on its
 assigned side, to a relative step of ``BRANCH_TOLERANCE``, then releases the
 floor and runs to its own tolerance; from a folded state, or one already on
 its branch (every passive M/V crease at least ``BRANCH_LEFT_DEG`` = 1e-3° on
-its side: a sweep's later frames), there is no such stage. Measured (bench/branch.py, default strategy): with the axis hinge
-every vertex (3 sector sets, both modes) and Miura sheet folds onto its
-assigned branch with or without the stage, but a thick Miura 10 × 10
-(H = 0.1 a, W = H, one crease driven) takes 662 iterations (53 s) without
-it and 36 (2.5 s) with it; with the arc and Eq. 8 hinges the stage is what
-makes mode B leave the flat state (Pehrson's vertex: 118° short without it,
-29.8° with it — the rest is their binding) and the thick Miura fold
-further (59.8° → 17.6° short).
+its side: a sweep's later frames), there is no such stage. With the axis
+hinge the stage mostly saves iterations; with the arc and Eq. 8 hinges it is
+what makes mode B leave the flat state: `docs/architecture.md#branch-selection`.
 """
 ACTUATIONS = ("equal", "angle")
 DEFAULT_ACTUATION = "equal"

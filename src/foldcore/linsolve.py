@@ -1,22 +1,13 @@
 """Sparse SPD factorisation behind one small interface: factor once, solve many.
 
-Backends: ``cholmod`` (scikit-sparse, simplicial — measured ~4× faster solves
-than supernodal on sheet-like matrices, DESIGN.md) and ``scipy`` (SuperLU), the
-fallback when scikit-sparse is not installed. ``refactor`` reuses the symbolic
-analysis (CHOLMOD) when only the values of K change.
-
-Fill-reducing ordering (CHOLMOD): its default (AMD, METIS only when AMD's
-fill looks poor) below ``NESTED_DISSECTION_FROM`` rows, CHOLMOD's nested
-dissection (``nesdis``) from there. Measured by ``bench/ordering.py`` on the
-scaling benchmark's Miura-ori K (2-core Xeon, 2026-11-25,
-``bench/results/ordering.json``), default → nesdis: at 88 796 rows
-(50 × 50) nnz(L) −15 %, solve 5.5 → 4.2 ms, analysis + numeric
-factorisation 0.16 → 0.22 s; at 357 596 rows (100 × 100) nnz(L) −21 %,
-solve 43 → 37 ms, numeric 1.30 → 0.63 s, analysis 0.13 → 0.73 s; at
-1 435 196 rows (200 × 200) nnz(L) −27 %, solve 225 → 179 ms, analysis +
-numeric 13.4 → 8.9 s. Below ~50 000 rows the two fill alike (20 × 20: −5 %)
-and nesdis's analysis costs more (3 → 15 ms at 20 × 20). A CHOLMOD built
-without METIS has no nesdis: the default ordering is used there.
+Backends: ``cholmod`` (scikit-sparse, simplicial: its solves are several
+times faster than supernodal ones on these sheet-like matrices) and
+``scipy`` (SuperLU), the fallback when scikit-sparse is not installed.
+``refactor`` reuses the symbolic analysis (CHOLMOD) when only the values
+change. CHOLMOD orders by its default (AMD) below ``NESTED_DISSECTION_FROM``
+rows and by nested dissection (``nesdis``, less fill on large sheets) from
+there; a CHOLMOD built without METIS has no nesdis and keeps its default.
+Why each choice, with the measurements: `docs/architecture.md#linear-solves`.
 """
 from __future__ import annotations
 
@@ -62,11 +53,9 @@ class Factor:
         What ``matrix`` holds: both triangles, or only the lower one (row ≥
         column) of the symmetric matrix. CHOLMOD reads only the lower triangle
         either way (scikit-sparse passes it as stype −1), so a lower-only
-        matrix gives the same factor from half the memory, as fast (the
-        rigid-body normal matrix of a thin Miura 20 × 20, 39 633 rows, six
-        interleaved refactorisations, 2-core Xeon guest, 2026-12-02: medians
-        33 vs 32 ms; 50 × 50, 255 093 rows: 294 vs 332 ms). SciPy's LU needs
-        both: it is mirrored there.
+        matrix gives the same factor from half the memory, as fast
+        (`docs/architecture.md#linear-solves`). SciPy's LU needs both: it is
+        mirrored there.
     """
 
     def __init__(self, matrix, backend: str = "auto", stored: str = "full"):

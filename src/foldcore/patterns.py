@@ -330,12 +330,14 @@ def miura_flat_widths(n: int, m: int, width: float) -> np.ndarray:
     theirs; an arc hinge of width W bent 180° has radius W / π (its panels 2W / π
     apart). With equal hinges the loop around the vertex misses by two layers
     (its first and third panel would share one) and the sheet stops short of
-    flat (``bench/os_miura.py``). In a Miura the odd crease is a straight one,
-    and every straight edge is the wrapping crease at one of its ends and the
-    odd one at the other, so along each straight line the widths grow by twice
-    the zig-zag width per vertex: zig-zag edges get ``width``, the k-th edge of
-    a straight line (k = 0 … n − 1, counted from the end where it wraps: the
-    left end on odd rows, the right one on even rows) ``(1 + 2k) · width``.
+    flat (`docs/architecture.md#a-thick-miura-has-no-flat-state-with-equal-hinges`;
+    ``bench/origami_simulator.py`` folds its graded-width row). In a Miura the
+    odd crease is a straight one, and every straight edge is the wrapping
+    crease at one of its ends and the odd one at the other, so along each
+    straight line the widths grow by twice the zig-zag width per vertex:
+    zig-zag edges get ``width``, the k-th edge of a straight line (k = 0 …
+    n − 1, counted from the end where it wraps: the left end on odd rows, the
+    right one on even rows) ``(1 + 2k) · width``.
     The axis hinge cannot use this: at 180° it pivots about its inner surface
     whatever its width (panels H apart).
 

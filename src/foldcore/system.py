@@ -4,7 +4,8 @@ With C the centring matrix of an element of m vertices,
 SᵀCS = diag(1 on its vertices) − (1/m)·11ᵀ, so K = diag(Σ w) − Bᵀ diag(w/m) B
 with B the element–vertex incidence matrix: assembled with two sparse products,
 no per-element Python loop. The right-hand side Σ w·Sᵀ(R T) is a *gather*
-through a vertex→slot CSR (each vertex sums its own slots: no races).
+through a vertex→slot CSR (each vertex sums its own slots: no races; why a
+gather: `docs/architecture.md#the-element-contract-gathers-it-does-not-scatter`).
 """
 from __future__ import annotations
 
@@ -114,7 +115,7 @@ class System:
 
     K alone is singular (free translation) and CHOLMOD may refuse it, so the
     first factorisation already pins vertex 0 with ``reference_weight`` — the
-    anchor a Simulation without position targets uses (no second factorisation
+    anchor a model without position targets uses (no second factorisation
     at setup) — until :meth:`set_pin_weights` says otherwise.
 
     Parameters
@@ -125,7 +126,7 @@ class System:
         Linear-solver backend (see :class:`foldcore.linsolve.Factor`).
     weights : sequence of (n_g,) float, optional
         Element weights to factor K with first, mm³ (default: the groups' own;
-        a Simulation passes its actuation's and stops' weights, so the first
+        the model passes its actuation's and stops' weights, so the first
         factorisation is already the one it needs).
 
     Attributes
@@ -163,10 +164,9 @@ class System:
 
     @property
     def factor(self) -> Factor:
-        """The factorisation of K with the pins, built at its first use. Why not at
-        construction: the rigid-body strategies never solve with K, and at a thin
-        Miura 50 × 50 (88 796 vertices, nnz(L) 2.0 M) it was 75 MB of the fold's
-        memory (RSS), and the coarse twin's Simulation factorised its own."""
+        """The factorisation of K with the pins, built at its first use: the
+        rigid-body strategies never solve with K, so a rigid-body fold never pays
+        its memory (`docs/architecture.md#linear-solves`)."""
         if self._factor is None:
             log.debug("K factorised: %d rows (%s)", self.n_vertices, self.backend)
             self._factor = Factor(self.with_pins(), self.backend)
@@ -180,8 +180,7 @@ class System:
     @property
     def matrix(self):
         """K without the pins, (N, N) sparse, mm³: assembled at its first use (as the
-        factor, and for the same reason: a rigid-body fold never needs it; 14 MB
-        at a thin Miura 50 × 50)."""
+        factor, and for the same reason: a rigid-body fold never needs it)."""
         if self._matrix is None:
             self._matrix = element_matrix(self.groups, self.weights, self.n_vertices)
         return self._matrix

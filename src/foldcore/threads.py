@@ -2,32 +2,22 @@
 
 numpy's and scipy's OpenBLAS run large dot products (n > ~10⁴: the weighted
 energy sum, L-BFGS's inner products, the rigid step's residual norms) on their
-own threads, which keep spinning for a while after each call. On a 2-core
-machine they then take a core from numba's parallel projection, which waits
-for its slowest thread: measured on Miura 50 × 50 (2-core Xeon), the hinge
-kernel took 16 ms on two numba threads against 10.6 ms on one; with BLAS held
-to one thread, 5.2 ms. While a :class:`~foldcore.simulation.Simulation` with
-more than one numba thread steps, BLAS runs on one thread (its calls there are
-vector operations that do not gain from threads); the previous setting is
-restored on exit, so the user's own BLAS work outside is unaffected.
-Caveat (measured with numpy's and scipy's OpenBLAS here): after the main
-thread lowered the count, a raise requested from another Python thread was
-ignored; so when the last guard to close runs in another thread than the
-first one opened, BLAS may stay on one thread.
+own threads, which keep spinning for a while after each call and take a core
+from numba's parallel projection, which waits for its slowest thread. While a
+:class:`~foldcore.simulation.Simulation` with more than one numba thread steps
+(or a serial one with vectors of ``BLAS_GUARD_FROM`` entries or more), BLAS
+runs on one thread (its calls there are vector operations that do not gain
+from threads); the previous setting is restored on exit, so the user's own
+BLAS work outside is unaffected. Caveat (numpy's and scipy's OpenBLAS): after
+the main thread lowered the count, a raise requested from another Python
+thread was ignored; so when the last guard to close runs in another thread
+than the first one opened, BLAS may stay on one thread.
 
-OpenMP's wait policy: numba's default threading layer here is GNU OpenMP
-(``omp``), whose idle threads spin ~300 000 polls before they sleep. On a
-shared machine a spinning sibling holds a core the next parallel loop needs,
-and that loop then waits a time slice at its end: with two CPU-bound
-competitors on 2 cores (``bench/load.py``, 2026-12-06, AMD EPYC guest), the
-99th percentile of a 2-thread L-BFGS step of Miura 10 × 10 was 39 × its
-quiet median and of a paper step of Miura 20 × 20 29 ×. ``import foldcore``
-therefore sets ``OMP_WAIT_POLICY=PASSIVE`` (idle threads sleep at once)
-unless the user set it: then 6.4 × and 4.5 ×, what a serial pure-Python
-loop of the same length measured beside them (6.1 ×, 3.2 ×); quiet steps
-cost the same within the noise. libgomp reads the variable once, when it loads; so it takes effect
-only if no OpenMP code was loaded before ``import foldcore``, and it is
-inherited by child processes.
+The thread count of each step (:func:`choose_threads`, :class:`ThreadChooser`)
+and OpenMP's wait policy, which ``import foldcore`` sets to ``PASSIVE`` unless
+the user set it (idle threads sleep instead of spinning; libgomp reads it once,
+when it loads, so only if no OpenMP code was loaded before, and child processes
+inherit it): why each, with the measurements, `docs/architecture.md#threads`.
 """
 from __future__ import annotations
 
@@ -96,16 +86,14 @@ class ThreadChooser:
     On a quiet machine the parallel projection is faster from a few hundred
     element-vertex slots on; on a shared one, a parallel loop waits at its end
     for a thread the scheduler took away, so a step can cost a time slice
-    (issue 17, ``bench/load.py``: a paper step of a Miura 4 × 4 at the 95th
-    percentile 48 ms instead of 0.17 ms with two CPU-bound competitors).
-    Now and then one step runs with the other count: after ``EXPLORE_EVERY``
-    steps, an interval that doubles (up to ``EXPLORE_MOST``) each time the
-    other count was still the slower, so a loaded machine pays for few
-    parallel probes; each count's cost is the median of its last ``WINDOW``
-    step times (a probe's time alone for the probed count: its older ones ran
-    under another load), and the cheaper one runs the others (the parallel
-    count until the serial one has been timed). The choice follows the load
-    as it changes.
+    (``bench/load.py``; `docs/architecture.md#threads`). Now and then one
+    step runs with the other count: after ``EXPLORE_EVERY`` steps, an interval
+    that doubles (up to ``EXPLORE_MOST``) each time the other count was still
+    the slower, so a loaded machine pays for few parallel probes; each count's
+    cost is the median of its last ``WINDOW`` step times (a probe's time alone
+    for the probed count: its older ones ran under another load), and the
+    cheaper one runs the others (the parallel count until the serial one has
+    been timed). The choice follows the load as it changes.
     """
 
     EXPLORE_EVERY = 16

@@ -6,7 +6,8 @@ is extrapolated from its last ``memory`` residuals f = G(x) − x, and the
 accelerated point is kept only if its energy is below the previous one —
 else the plain step from the last accepted point is taken and the history
 forgotten. Shared bookkeeping and the energy's gradient:
-:mod:`.accelerated`.
+:mod:`.accelerated`. Where it serves and where it does not:
+`docs/architecture.md#the-accelerated-maps`.
 """
 from __future__ import annotations
 

@@ -4,7 +4,8 @@ Liu, Bouaziz & Kavan 2017, "Quasi-Newton methods for real-time simulation of
 hyperelastic materials": the two-loop recursion with H₀ = K⁻¹ (one K solve
 per iteration) and an Armijo backtracking line search on E; when the search
 fails the plain step is taken and the history forgotten. Shared bookkeeping
-and the energy's gradient: :mod:`.accelerated`.
+and the energy's gradient: :mod:`.accelerated`. Where it serves and where it
+does not: `docs/architecture.md#the-accelerated-maps`.
 """
 from __future__ import annotations
 

@@ -3,13 +3,8 @@
 Why: a mesh with elastic cells (``thicken(elastic=...)``) has no rigid
 bodies for the ``rigid`` strategy, and the local/global strategies crawl on
 it: the cells of a thin sheet are stiff in their plane and soft in bending,
-so L-BFGS from K⁻¹ needs tens of thousands of iterations and its verdict
-stalls (measured, 2-core Xeon guest, load 1.4, 2026-12-03, sheets of 100 mm,
-H = 0.5 mm, every face in rings, from rest, tolerance 1e-8: Origami
-Simulator's square twist at 30 %, 20 mm cells: L-BFGS 9 198 iterations,
-1.9 s, this strategy 24 steps, 0.38 s; the crane at 30 %, 10 mm cells:
-L-BFGS 40 000 iterations, 36 s, stalled, this strategy 34 steps, 2.1 s,
-converged; the same states to 1e-5°).
+so L-BFGS from K⁻¹ needs tens of thousands of iterations where this strategy
+takes tens of steps (`docs/architecture.md#newton`).
 
 The energy is the paper's, E(x) = Σ_e w_e ‖C x_e − P_e(x)‖² (+ pins), P_e the
 element's projection: its target shape, best rotated (:mod:`elements`). Since
@@ -24,24 +19,23 @@ freedom is left out of H, which then overestimates the strip's stiffness: the
 step is shorter, never wrong, since each step must lower E.
 
 A step solves (H + λ D) δ = −(K x − b), D the diagonal of K ⊗ I₃
-(Levenberg–Marquardt, damping λ relative), then takes ``CORRECTIONS`` steps
+(Levenberg–Marquardt, damping λ relative), then takes ``corrections`` steps
 of the paper's map from x + δ: a linear step turns a panel by stretching it
-(O(L ω²)), and the map restores the cells' shapes (measured on the FOLD
-project's diagonal fold to 162° from flat, 10 mm cells: 60 steps reached 28°
-without the correction, 46° with one, 80° with three). Large rotations still
+(O(L ω²)), and the map restores the cells' shapes. Large rotations still
 cost many steps: ``hybrid`` therefore starts such a mesh on its rigid-panel
 twin (:mod:`.hybrid`) and uses this strategy to finish. The step is kept if E
-decreases (λ ÷ ``LAMBDA_DOWN``), else λ × ``LAMBDA_UP`` and it is solved again.
+decreases (λ ÷ ``lambda_down``), else λ × ``lambda_up`` and it is solved again
+(the fields of :class:`NewtonOptions`).
 
 Verdict (:meth:`Newton.settled`): an accepted, nearly undamped step within
-the run's limit, after an accepted step at most ``CONTRACTION_MAX`` times
+the run's limit, after an accepted step at most ``contraction_max`` times
 longer, so the distance left (the geometric tail of the steps) is within the
 limit too — or, on a compatible fold, E down to tolerance² of the run's
 largest, where the steps are rounding.
 
 Cost per step: one assembly of H into a fixed pattern (:class:`HessianPattern`)
 and one sparse Cholesky per trial (CHOLMOD refactors in place, else SciPy),
-plus 1 + ``CORRECTIONS`` local steps and K solves per trial (the accepted
+plus 1 + ``corrections`` local steps and K solves per trial (the accepted
 trial's projections serve the next step). Units: mm.
 """
 from __future__ import annotations
@@ -109,13 +103,13 @@ class Newton(Strategy):
                                   f"bending hinges (mesh has {sorted(other)}); use 'lbfgs'")
         self.lam = self.options.lambda_start
         self.accepted = False
-        self.undamped = False  # whether the last accepted step's damping was ≤ LAMBDA_SETTLED
+        self.undamped = False  # whether the last accepted step's damping was ≤ lambda_settled
         self.moves = []  # the run's accepted step lengths, mm
         self.level = 0  # accepted steps in a row whose E changed within rounding (stalled)
         self.energy, self.energy_max = np.inf, 0.0  # after the last step; the run's largest, mm⁵
         #: mm⁵: the energy of residuals at rounding level (every vertex off by ROUNDING ×
         #: the size), below which changes are noise even where E is zero (targets met
-        #: at rest: a fold at 0 % took 17 rejected factorisations per step before)
+        #: at rest: without it a fold at 0 % took 17 rejected factorisations per step)
         self.energy_floor = (model.system.reference_weight * model.mesh.n_vertices
                              * (ROUNDING * model.length_scale) ** 2)
 
@@ -172,8 +166,8 @@ class Newton(Strategy):
         return energy, rhs, self.model.slot_targets
 
     def settled(self, moved: float, limit: float) -> bool:
-        """An accepted step, damped at most ``LAMBDA_SETTLED``, within ``limit`` mm,
-        after a step at most ``CONTRACTION_MAX`` times longer (the steps' tail,
+        """An accepted step, damped at most ``lambda_settled``, within ``limit`` mm,
+        after a step at most ``contraction_max`` times longer (the steps' tail,
         moved·r/(1 − r) with r their ratio, is then within the limit too) or with
         E down to tolerance² of the run's largest (a compatible fold: the residuals
         are at the tolerance, the steps at rounding). A step that no damping makes
@@ -186,14 +180,12 @@ class Newton(Strategy):
 
     @property
     def stalled(self) -> bool:
-        """``STALL_STEPS`` accepted steps in a row changed E by no more than rounding
+        """``stall_steps`` accepted steps in a row changed E by no more than rounding
         (``ROUNDING`` × the run's largest E + the floor) and the last third of them
         were no shorter than half the first third's: the steps wander at the
-        resolution E can judge. Measured: a thick Miura 6 × 6 driven flat at
-        tolerance 1e-13 (limit 1.2e-11 mm) handed over by the rigid phase took
-        steps of ~1e-8 mm at E = 0.0713809325 mm⁵ to its 3 000-step budget
-        (23 s); steps that still shrink (a contraction of 0.85 at rounding
-        level) are converging and go on."""
+        resolution E can judge, where without this a binding fold at a tight
+        tolerance ran its whole budget; steps that still shrink are converging
+        and go on (`docs/architecture.md#newton`)."""
         steps = self.options.stall_steps
         if self.level < steps:
             return False
@@ -202,7 +194,7 @@ class Newton(Strategy):
         return max(window[-third:]) >= 0.5 * max(window[:third])
 
     def _corrected(self, x: np.ndarray) -> np.ndarray:
-        """``x`` after ``CORRECTIONS`` steps of the paper's map (projections, K solve)."""
+        """``x`` after ``corrections`` steps of the paper's map (projections, K solve)."""
         for _ in range(self.options.corrections):
             _, rhs = self.model.local_step(x)
             x = self.model.global_step(rhs)
@@ -259,12 +251,8 @@ class HessianPattern:
     Built once per K (``system.version``), so a step assembles H by one
     ``bincount`` instead of SciPy's COO → CSR → sum → CSC conversions, and the
     pattern, explicit zeros kept, is the same at every step: CHOLMOD reuses its
-    symbolic analysis. Measured (2-core Xeon guest, 2026-12-03, cProfile): on
-    Origami Simulator's Miura 12 × 13 in graded arc hinges (16 944 unknowns)
-    the assembly fell from 55 to 14 ms per step and a factorisation from 40 to
-    30 ms; whole runs, 3 interleaved rounds against the SciPy assembly: that
-    Miura flat 3.25–3.41 → 1.73–1.78 s, the crane at 30 % in 10 mm rings
-    2.05–2.26 → 1.06–1.11 s, the same 26 and 34 steps, angles equal to 1e-9°.
+    symbolic analysis (about half a whole run's time saved:
+    `docs/architecture.md#newton`).
 
     Parameters
     ----------
@@ -320,9 +308,8 @@ def _without_rigid_motion(delta: np.ndarray, x: np.ndarray) -> np.ndarray:
     """``delta`` (N, 3) mm without its component along the whole sheet's rigid motions
     (translations and infinitesimal rotations ω × (x − x̄)). Without position targets
     E does not change along them (the anchor pin follows vertex 0), so H is
-    singular there and a nearly undamped step moves the sheet by rounding
-    (measured: Origami Simulator's simpleVertex in rings kept moving 2e-4 mm per
-    step at E constant to 10 digits for 1 500 steps)."""
+    singular there and a nearly undamped step moves the sheet by rounding, step
+    after step at a constant E (`docs/architecture.md#newton`)."""
     arm = x - x.mean(axis=0)
     zero, one = np.zeros(len(x)), np.ones(len(x))
     modes = [np.column_stack([one, zero, zero]), np.column_stack([zero, one, zero]),

@@ -1,12 +1,12 @@
 """Normal equations of the rigid-body step, assembled strip by strip in numba.
 
-Why: the rigid-body Levenberg–Marquardt step (:mod:`foldcore.rigid_body`)
-solves (JᵀJ + λD) δq = −Jᵀr. Forming the sparse Jacobian J and multiplying
-it with SciPy (J = J_x·P, then JᵀJ, then format conversions) cost 60 % of a
-step (Miura 20 × 20, 0.38 s per step, 2026-12-02); a bare solve of the paper's
-K at that size takes 1.1 ms. Here JᵀJ's values are written directly into a
-CSC matrix whose pattern is fixed per column layout (so CHOLMOD reuses its
-symbolic analysis across steps), and Jᵀu, J·v are applied without J.
+Why: the rigid-body Levenberg–Marquardt step (:mod:`.step`) solves
+(JᵀJ + λD) δq = −Jᵀr, and forming the sparse Jacobian J and multiplying it
+with SciPy cost most of a step
+(`docs/architecture.md#normal-equations-without-j`). Here JᵀJ's values are
+written directly into a CSC matrix whose pattern is fixed per column layout
+(so CHOLMOD reuses its symbolic analysis across steps), and Jᵀu, J·v are
+applied without J.
 
 The strip rows. Strip s (8 vertices k) has residual rows
 r_k = √w (x_k − x̄ − R t_k); a vertex moves with the unknowns as
@@ -27,9 +27,8 @@ move), its hinge-interior vertices (3 each), its rotation (3) and, when its
 crease is passive, its crease's angle (1).
 
 Pattern: the lower triangle (row ≥ column; CHOLMOD reads only that one,
-:class:`foldcore.linsolve.Factor`; half the entries to write and keep: Miura
-20 × 20 0.66 M instead of 1.27 M, assembly 25 → 20 ms interleaved) of every
-local pair but the structural zeros (two hinge-interior
+:class:`foldcore.linsolve.Factor`; half the entries to write and keep) of
+every local pair but the structural zeros (two hinge-interior
 coordinates of different axes), every diagonal entry and every panel's 6 × 6
 block (position targets and M/V side rows add only there or inside a strip's
 block). Units: mm, rad.
@@ -569,7 +568,7 @@ def place_on_panels(rot_p, c_p, vertex, panel, body, x):
 @njit(cache=True, inline="always")
 def mv_side_at(t, wall, slack):
     """(value, slope) of an M/V side row's shape at ``t`` rad (one crease; the
-    shape and why: :func:`foldcore.rigid_body.mv_side`)."""
+    shape and why: :func:`.residual.mv_side`)."""
     turn = -(wall * math.pi + slack) / (1.0 + wall)  # where the two branches meet
     if t < -slack and t >= turn:
         return t + slack, 1.0
