@@ -18,9 +18,9 @@ same run*. This benchmark runs both, interleaved, ``ROUNDS`` rounds:
   node strain shown as "global error") until the mean strain is below each
   of ``STRAINS`` (percent) or ``OS_LIMIT_S`` passes (a threshold counts once
   the strain has risen to the first one: the sheet starts flat and unstrained). Time is
-  ``performance.now()`` from the first step; the drawing of the scene is not
-  counted (in the app every 100 steps also draw a frame), so Origami
-  Simulator's times here are lower bounds of what its users wait for. At
+  ``performance.now()`` from the first step. The harness yields to the page
+  between chunks of 100 steps, where the page may draw a frame, so the times
+  can include drawing (in the app every 100 steps also draw a frame). At
   each threshold the node positions are taken, and the fold angle of every
   M/V crease is measured from them (Python side: the angle between the two
   triangles' normals) against its target (±180°).
