@@ -10,8 +10,12 @@ import platform
 import numpy as np
 
 from .io.fold_json import CELLS_KEY, HINGE_KEY, POISSON_KEY
-from .mesh import surface_faces
+from .mesh import surface_polygons
 
+#: Keys of a folded frame naming each face's part: the crease-pattern face of a panel
+#: (or elastic cell) face, the crease of a hinge-strip face; null for the other kind.
+FACE_PART_KEY = "foldcore:faces_face"
+EDGE_PART_KEY = "foldcore:faces_edge"
 #: FOLD key marking a result written from an interrupted run's last iterate.
 PARTIAL_KEY = "foldcore:partial"
 #: Keys of a series frame: its fold percent, and per key-frame edge the achieved
@@ -22,11 +26,24 @@ SERIES_TARGET_KEY = "foldcore:pattern_targetAngle"
 
 
 def folded_frame(mesh, positions: np.ndarray) -> dict:
-    """FOLD frame of the folded thick solid: 3D coordinates (mm) and surface faces."""
+    """FOLD frame of the folded thick solid: 3D coordinates (mm), surface faces, and
+    the part each face belongs to (``foldcore:faces_face``: the crease-pattern face
+    of a panel face, ``foldcore:faces_edge``: the crease of a hinge-strip face;
+    null for the other kind and for faces of no pattern item), so the solid can be
+    checked part by part."""
+    surface = surface_polygons(mesh)
+    known = surface.source >= 0
     return {"frame_classes": ["foldedForm"], "frame_attributes": ["3D"],
             "frame_unit": "mm", "frame_parent": 0, "frame_inherit": False,
             "vertices_coords": np.asarray(positions).tolist(),
-            "faces_vertices": [f.tolist() for f in surface_faces(mesh)]}
+            "faces_vertices": [f.tolist() for f in surface.loops],
+            FACE_PART_KEY: _items(surface.source, known & ~surface.is_hinge),
+            EDGE_PART_KEY: _items(surface.source, known & surface.is_hinge)}
+
+
+def _items(ids: np.ndarray, where: np.ndarray) -> list:
+    """``ids`` as a JSON list of ints, null where ``where`` is False."""
+    return [int(i) if w else None for i, w in zip(ids.tolist(), where.tolist())]
 
 
 def series_frame(mesh, result, percent: float) -> dict:
