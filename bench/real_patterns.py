@@ -56,19 +56,12 @@ def wrong_side(assignments, angles) -> int:
 
 
 def simulate(path, percent: float, elastic_cells, budget: int):
-    """:func:`foldcore.simulate` of ``path`` with this benchmark's settings, in its grouped
-    options (``reading``, ``thickening``, ``solving``) or, in a foldcore without them, its
-    keyword options."""
-    import inspect
-
+    """:func:`foldcore.simulate` of ``path`` with this benchmark's settings."""
     import foldcore
 
-    if "solving" in inspect.signature(foldcore.simulate).parameters:
-        return foldcore.simulate(path, reading={"size": SHEET},
-                                 thickening={"thickness": H, "elastic_cells": elastic_cells},
-                                 solving={"fold_percent": percent, "max_iterations": budget})
-    return foldcore.simulate(path, thickness=H, sheet_size=SHEET, fold_percent=percent,
-                             max_iterations=budget, elastic_cells=elastic_cells)
+    return foldcore.simulate(path, reading={"size": SHEET},
+                             thickening={"thickness": H, "elastic_cells": elastic_cells},
+                             solving={"fold_percent": percent, "max_iterations": budget})
 
 
 def run_one(path, percent: float, elastic_cells=None, budget=BUDGET) -> dict:
