@@ -30,8 +30,10 @@ from foldcore import patterns
 from foldcore.strain import neutral_lengths
 from foldcore.cli import main
 from foldcore.errors import PatternError
-from foldcore.fabrication import (ExportError, atomic_path, read_result, sheet_outlines,
-                                  stl_bytes, surface_triangles, triangulate_polygon)
+from foldcore.fabrication import ExportError, sheet_outlines
+from foldcore.files import atomic_path
+from foldcore.result_file import read_result
+from foldcore.surface import stl_bytes, surface_triangles, triangulate_polygon
 
 SVG_NS = "{http://www.w3.org/2000/svg}"
 
@@ -385,7 +387,7 @@ def test_stretch_hinges_join_the_sheet_and_bars_have_no_surface(tmp_path):
     HINGE outline); a 2-vertex element (examples/plugin_bar) adds no faces."""
     import dataclasses
 
-    from foldcore.fabrication import surface_polygons
+    from foldcore.mesh import surface_polygons
     from foldcore.thickening import thicken
 
     pattern = patterns.single_hinge(panel_length=10.0, depth=10.0, width=2.0)

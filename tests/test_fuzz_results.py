@@ -31,8 +31,9 @@ from hypothesis import strategies as st
 from foldcore import patterns
 from foldcore.cli import main
 from foldcore.errors import FoldcoreError
-from foldcore.fabrication import (ExportError, ResultFile, read_result, sheet_outlines,
-                                  stl_bytes)
+from foldcore.fabrication import ExportError, sheet_outlines
+from foldcore.result_file import ResultFile, read_result
+from foldcore.surface import stl_bytes
 from foldcore.io import write_fold
 from test_fuzz_readers import FUZZ, GARBAGE, NASTY_FLOATS, NASTY_INTS, NASTY_TEXT, \
     _json_bytes, fold_mutation

@@ -109,7 +109,7 @@ def test_result_file_keeps_targets(tmp_path):
 def test_hinge_models_read_and_travel_with_results(tmp_path):
     """foldcore:edges_hinge is read per edge (null = default) and written into
     result files, so render/export rebuild the mesh with the models simulated."""
-    from foldcore.fabrication import read_result
+    from foldcore.result_file import read_result
     from foldcore.outputs import write_result
     from foldcore.simulation import Simulation
     from foldcore.thickening import thicken

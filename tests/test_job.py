@@ -153,7 +153,7 @@ def test_a_crease_past_flat_reads_back_and_keeps_its_side(tmp_path):
     import dataclasses
 
     from folded import scene
-    from foldcore.fabrication import read_result
+    from foldcore.result_file import read_result
     from foldcore.outputs import write_result
 
     pattern, mesh, result = scene("hinge")
@@ -184,7 +184,7 @@ def test_elastic_cells_cut_every_face_into_rings_and_fold_a_compatible_target(tm
     file), recorded in the report. The FOLD project's diagonal fold (one crease, two
     triangles) is compatible, so elastic panels meet its target as rigid ones do —
     to the tolerance's angle, 1e-8 × size / cell size ≈ 1e-4° at most."""
-    from foldcore.fabrication import read_result
+    from foldcore.result_file import read_result
 
     report = tmp_path / "diag.json"
     done = foldcore.job.fold(REAL + "diagonal-cp.fold", reading={"size": 100.0},

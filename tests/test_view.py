@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from foldcore.cli import main
-from foldcore.fabrication import read_result
+from foldcore.result_file import read_result
 
 CHROMIUM = "/usr/bin/chromium"
 FLAGS = ["--headless", "--no-sandbox", "--disable-gpu", "--enable-unsafe-swiftshader",

@@ -3,7 +3,7 @@
 Readers (in-process, the public ones): FOLD (``foldcore.io.read_fold_file``,
 what ``foldcore simulate`` reads), OBJ, STL (ASCII and binary) and hinge
 files (``foldcore.read``) and result files
-(``foldcore.fabrication.read_result``), each corrupted 1–3 times by plain
+(``foldcore.result_file.read_result``), each corrupted 1–3 times by plain
 random mutations (fixed seed) of real files: the hinge scene and a degree-4
 vertex (their result files written by ``foldcore simulate -o``). Counted per
 reader: accepted, refused (a FoldcoreError), unhandled (any other
@@ -236,7 +236,7 @@ def generated(kind: str, bases: dict, rng: random.Random):
 # ------------------------------------------------------------------ readers
 def read(kind: str, folder: Path):
     import foldcore
-    from foldcore.fabrication import read_result
+    from foldcore.result_file import read_result
     from foldcore.io import read_fold_file
 
     if kind == "fold":

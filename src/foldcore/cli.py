@@ -32,6 +32,7 @@ import warnings
 from .hinges import DEFAULT_HINGE, HINGE_MODELS
 from .actuation import ACTUATIONS, BRANCH_FLOOR_DEG, DEFAULT_ACTUATION
 from .destinations import check_destinations
+from .options import MAX_FPS, MAX_FRAMES
 from .strategies import DEFAULT_SOLVER, SOLVERS
 
 EXIT_BAD_INPUT = 2
@@ -92,15 +93,16 @@ def _frames(text: str) -> int:
         value = int(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f"expected an integer ≥ 2, got {text!r}")
-    if not 2 <= value <= 10_000:
-        raise argparse.ArgumentTypeError(f"expected an integer in 2..10000, got {value}")
+    if not 2 <= value <= MAX_FRAMES:
+        raise argparse.ArgumentTypeError(f"expected an integer in 2..{MAX_FRAMES}, got {value}")
     return value
 
 
 def _fps(text: str) -> float:
     value = _positive(text)
-    if value > 100:
-        raise argparse.ArgumentTypeError(f"expected frames per second in (0, 100], got {text}")
+    if value > MAX_FPS:
+        raise argparse.ArgumentTypeError(f"expected frames per second in (0, {MAX_FPS:g}], "
+                                         f"got {text}")
     return value
 
 
@@ -400,12 +402,12 @@ def _why(result) -> str:
 def render_result(args) -> int:
     """Run ``foldcore render``; raises FoldcoreError on bad input.
 
-    The thick mesh is rebuilt from the file (:func:`foldcore.fabrication.read_result`)
+    The thick mesh is rebuilt from the file (:func:`foldcore.result_file.read_result`)
     rather than the stored surface drawn as it is: the stored faces carry no
     panel/hinge or mountain/valley information, the rebuilt mesh does, and it
     is accepted only when its surface equals the stored one.
     """
-    from .fabrication import read_result
+    from .result_file import read_result
     from .measure import fold_angles
     from .render import colour_limits, per_strip, render_png, strip_bend_angles
 
@@ -433,7 +435,8 @@ def render_result(args) -> int:
 
 def export_result(args) -> int:
     """Run ``foldcore export``; raises FoldcoreError on bad input."""
-    from .fabrication import ExportError, export, read_result
+    from .fabrication import ExportError, export
+    from .result_file import read_result
 
     if not (args.svg or args.dxf or args.stl):
         raise ExportError(f"{args.result}: nothing to export: give --svg, --dxf and/or --stl")

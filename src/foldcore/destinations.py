@@ -4,14 +4,14 @@ A destination that cannot be written is found before the run, not after a
 long fold, and the message names the option and the path as the user gave
 them. The files themselves are written by :mod:`foldcore.files`: each to a
 temporary name in its own folder, renamed over the destination only when
-every writer has succeeded (:func:`all_or_nothing`), the temporary files
+every writer has succeeded (:func:`foldcore.files.all_or_nothing`), the temporary files
 removed on any error or signal.
 """
 from __future__ import annotations
 
 import os
 
-from .files import OutputError, all_or_nothing  # noqa: F401  (part of this API)
+from .files import OutputError
 
 
 def check_destinations(outputs: dict, inputs=(), suffixes: dict | None = None) -> None:

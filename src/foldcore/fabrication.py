@@ -26,24 +26,19 @@ Folded solid (3D printing, CAD): binary STL (mm) of the outer surface,
 :func:`foldcore.surface.write_stl`. Result files (``foldcore simulate -o``)
 are read back by :func:`foldcore.result_file.read_result`. Every file is
 written atomically (:mod:`foldcore.files`): it appears complete or not at all.
-The public names of those modules are re-exported here. Design notes:
+Design notes:
 ``docs/architecture.md#fabrication-files``.
 """
 from __future__ import annotations
 
 import io
-from contextlib import contextmanager
 
 import numpy as np
 
 from . import files
-from .files import ExportError  # noqa: F401  (part of this API)
-from .mesh import SurfaceFaces, surface_polygons  # noqa: F401  (part of this API)
-from .result_file import (FOOTPRINT_TOLERANCE, MAX_REACH,  # noqa: F401  (part of this API)
-                          ResultFile, read_result)
-from .surface import (TriangulationError, enclosed_volume,  # noqa: F401  (part of this API)
-                      stl_bytes, surface_edges, surface_triangles, triangulate_polygon,
-                      write_stl)
+from .files import ExportError
+from .result_file import ResultFile
+from .surface import stl_bytes
 
 LAYERS = {"CUT": {"dxf_colour": 7, "svg": "#000000"},      # black: the boundary
           "PANEL": {"dxf_colour": 8, "svg": "#808080"},    # grey
@@ -59,22 +54,6 @@ SVG_STROKE_MAX_MM = 0.1
 
 
 # ------------------------------------------------------------------- writing
-@contextmanager
-def atomic_path(path, suffix: str | None = None):
-    """:func:`foldcore.files.atomic_path` after checking the folder exists
-    (:class:`ExportError` naming it); the temporary name ends with ``suffix``
-    (default: ``path``'s own suffix), so format-by-name writers still work."""
-    files.check_folder(path, ExportError)
-    with files.atomic_path(path, suffix) as tmp:
-        yield tmp
-
-
-def write_bytes(path, data: bytes) -> None:
-    """Write ``data`` to ``path`` atomically, after checking its folder (ExportError)."""
-    files.check_folder(path, ExportError)
-    files.write_bytes(path, data)
-
-
 def _write_text(path, text: str) -> None:
     """Write ``text`` to ``path`` atomically, after checking its folder (ExportError)."""
     files.check_folder(path, ExportError)

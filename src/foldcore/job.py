@@ -23,16 +23,6 @@ from .errors import RunWarning
 from .options import OptionError
 
 
-@dataclass(frozen=True)
-class Loaded:
-    """A pattern file read: the pattern and the file-level values thicken() takes."""
-
-    pattern: object  # CreasePattern
-    thickness: float | None  # mm, the file's foldcore:thickness
-    stiffness: dict | None
-    hinge: list | None
-
-
 class Interrupted(KeyboardInterrupt):
     """Ctrl-C during the run: the last iterate was written as a partial result
     (``foldcore:partial`` in the FOLD file, ``reason: "interrupted"`` in the
@@ -53,15 +43,6 @@ class Fold:
     result: object  # Result
     settings: dict  # recorded in the report
     summary: str  # one line: verdict, iterations, time, miss
-
-
-def load(path, *, hinges=None, reading=None) -> Loaded:
-    """Read a FOLD or SVG file, or an OBJ/STL mesh with its hinge file
-    (:func:`foldcore.io.read_file`, which chooses the reader by suffix)."""
-    from .io import read_file
-
-    read = read_file(path, hinges=hinges, reading=reading)
-    return Loaded(read.pattern, read.thickness, read.stiffness, read.hinge)
 
 
 def simulate(path, *, hinges=None, reading=None, thickening=None, solving=None,
@@ -171,10 +152,11 @@ def _prepared(job: Job):
     """The pattern read and its thickness (mm), every output path checked: all that can
     fail on the inputs fails here, before any work."""
     from .destinations import check_destinations
+    from .io import read_file
     from .limits import check_inputs
 
     t = job.thickening
-    loaded = load(job.source, hinges=job.hinges, reading=job.reading)
+    loaded = read_file(job.source, hinges=job.hinges, reading=job.reading)
     check_inputs(loaded.pattern, t.thickness, t.hinge_width, loaded.stiffness)
     thickness = t.thickness or loaded.thickness
     if thickness is None:
@@ -189,7 +171,8 @@ def _prepared(job: Job):
 
 
 def _simulation(job: Job, loaded, thickness: float):
-    """(mesh, Simulation) of the job's pattern."""
+    """(mesh, Simulation) of the job's pattern (``loaded``: the file read,
+    :class:`foldcore.io.FoldFile`)."""
     from .simulation import Simulation
     from .thickening import thicken
 

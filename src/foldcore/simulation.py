@@ -21,6 +21,7 @@ from .actuation import BRANCH_FLOOR_DEG, BRANCH_TOLERANCE, DEFAULT_ACTUATION
 from .convergence import ConvergenceTest, Progress
 from .errors import SimulationError
 from .model import Model
+from .model.model import BARE_SOLVE_REPEATS
 from .result import Result
 from .strategies import DEFAULT_SOLVER
 from .threads import BLAS_GUARD_FROM, ThreadChooser, blas_on_one_thread, choose_threads
@@ -224,7 +225,7 @@ class Simulation:
     def hinge_misfits(self) -> np.ndarray:
         return self.model.hinge_misfits()
 
-    def bare_solve_seconds(self, repeats: int = 5) -> float:
+    def bare_solve_seconds(self, repeats: int = BARE_SOLVE_REPEATS) -> float:
         """Median seconds of one K⁻¹ solve (:meth:`Model.bare_solve_seconds`)."""
         return self.model.bare_solve_seconds(repeats)
 

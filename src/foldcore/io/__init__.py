@@ -13,8 +13,8 @@ from pathlib import Path
 from ..errors import PatternError
 from ..pattern import CreasePattern
 from .conventions import Reading
-from .fold import (MAX_FILE_BYTES, FoldFile, fold_dict, pattern_from_fold_dict, read_fold,
-                   read_fold_file, write_fold)
+from .fold import MAX_FILE_BYTES, FoldFile, pattern_from_fold_dict, read_fold, read_fold_file
+from .fold_write import fold_dict, write_fold
 from .obj import mesh_edges, read_mesh, write_hinges, write_obj
 
 __all__ = ["MAX_FILE_BYTES", "FoldFile", "Reading", "fold_dict", "mesh_edges",

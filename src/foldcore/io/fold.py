@@ -58,7 +58,6 @@ import numpy as np
 
 from .. import limits
 from ..errors import PatternError
-from ..files import atomic_path, atomic_write  # noqa: F401  (part of this API)
 from ..hinges import HINGE_MODELS
 from ..pattern import DEFAULT_MAX_ANGLE_DEG, CreasePattern
 from ..planar import derive_face_loops, has_repeats, loop_starts, next_in_loop
@@ -67,7 +66,6 @@ from .fold_json import (ARRAY, CELLS_KEY, EDGE_STIFFNESS_KEY,  # noqa: F401  (pa
                         FACE_STIFFNESS_KEY, HINGE_KEY, MAX_ANGLE_KEY, POISSON_KEY, TARGET_KEY,
                         THICKNESS_KEY, UNIT_MM, WIDTH_KEY, check_length, fail, index, int_table,
                         number, number_table, parse_json, required_list, short)
-from .fold_write import fold_dict, write_fold  # noqa: F401  (part of this API)
 
 #: Largest input file read, bytes (256 MiB).
 MAX_FILE_BYTES = 256 * 1024 * 1024

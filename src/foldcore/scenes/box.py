@@ -57,7 +57,7 @@ panels' centroids sit inside the corners (``fin_inward_mm``); the thick 2D sheet
 volumes (mm³):
 
 * ``material`` — the folded solid's own volume (its closed outer surface,
-  :func:`foldcore.fabrication.enclosed_volume`), beside its rest volume;
+  :func:`foldcore.surface.enclosed_volume`), beside its rest volume;
 * ``capacity`` = volume of the convex hull of the folded solid − material.
   It counts the fins and the walls' thickness as lost capacity; it also
   counts as capacity the small gaps between the hull and the outer
@@ -76,7 +76,8 @@ import time
 
 import numpy as np
 
-from ..fabrication import enclosed_volume, sheet_outlines, surface_triangles
+from ..fabrication import sheet_outlines
+from ..surface import enclosed_volume, surface_triangles
 from ..measure import dihedral_deg
 from ..pattern import CreasePattern
 from ..simulation import Simulation
