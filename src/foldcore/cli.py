@@ -32,7 +32,7 @@ import warnings
 from .hinges import DEFAULT_HINGE, HINGE_MODELS
 from .actuation import ACTUATIONS, BRANCH_FLOOR_DEG, DEFAULT_ACTUATION
 from .destinations import check_destinations
-from .options import MAX_FPS, MAX_FRAMES
+from .options import CONTACT_CHOICES, MAX_FPS, MAX_FRAMES
 from .strategies import DEFAULT_SOLVER, SOLVERS
 
 EXIT_BAD_INPUT = 2
@@ -212,6 +212,10 @@ def _add_solving(sim) -> None:
                      help="from a flat sheet, first fold with passive M/V creases held at "
                           "least DEG degrees on their assigned side, then release them "
                           f"(branch selection; 0 turns it off; default {BRANCH_FLOOR_DEG:g})")
+    sim.add_argument("--contact", choices=CONTACT_CHOICES, default="off",
+                     help="on: panels no crease joins never pass through each other (IPC "
+                          "barrier and collision-checked steps; needs --solver rigid and the "
+                          "ipctk package); default off")
 
 
 def _add_outputs(sim) -> None:
@@ -336,7 +340,8 @@ def option_groups(args) -> dict:
             "thickening": Thickening(args.thickness, args.hinge_width, args.subdivisions,
                                      args.hinge, args.elastic_cells),
             "solving": Solving(args.fold_percent, args.solver, args.tolerance,
-                               args.max_iterations, args.actuation, args.branch_floor),
+                               args.max_iterations, args.actuation, args.branch_floor,
+                               contact=args.contact),
             "outputs": Outputs(args.output, args.report, args.render, args.animate,
                                args.series, args.frames, args.fps)}
 

@@ -182,7 +182,8 @@ def _simulation(job: Job, loaded, thickness: float):
                    hinge=t.hinge or loaded.hinge, stiffness=loaded.stiffness,
                    elastic="facets" if cells else None, cell_size=cells)
     sim = Simulation(mesh, loaded.pattern, solver=s.solver, actuation=s.actuation,
-                     branch_floor_deg=s.branch_floor, options=s.strategy_options)
+                     branch_floor_deg=s.branch_floor, options=s.strategy_options,
+                     contact=s.contact == "on")
     return mesh, sim
 
 
@@ -194,6 +195,7 @@ def _settings(job: Job, thickness: float, mesh, sim) -> dict:
             "subdivisions": t.subdivisions, "thickness_mm": thickness,
             "hinge": sorted(set(mesh.hinge_model) - {""}), "actuation": s.actuation,
             "branch_floor_deg": s.branch_floor, "elastic_cells_mm": t.elastic_cells,
+            "contact": s.contact,
             "backend": sim.system.backend}
 
 

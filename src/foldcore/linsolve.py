@@ -22,6 +22,16 @@ def cholmod_ordering(n_rows: int) -> str:
     return "nesdis" if n_rows >= NESTED_DISSECTION_FROM else "default"
 
 
+def not_positive_definite() -> tuple:
+    """Exception classes a factorisation raises for a matrix that is not positive
+    definite (CHOLMOD's; SciPy's LU raises RuntimeError for a singular one)."""
+    try:
+        from sksparse.cholmod import CholmodNotPositiveDefiniteError
+    except ImportError:
+        return (RuntimeError,)
+    return (CholmodNotPositiveDefiniteError, RuntimeError)
+
+
 def cholmod_available() -> bool:
     try:
         import sksparse.cholmod  # noqa: F401

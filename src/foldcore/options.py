@@ -19,6 +19,7 @@ from .hinges import HINGE_MODELS
 from .strategies import DEFAULT_SOLVER
 
 MAX_FRAMES = 10_000
+CONTACT_CHOICES = ("off", "on")
 MAX_FPS = 100.0
 
 
@@ -104,6 +105,9 @@ class Solving:
         fold leaves the flat sheet (0: off).
     strategy_options : dataclass, optional
         The strategy's own options (its ``Options`` class).
+    contact : {"off", "on"}
+        ``"on"``: panels that no crease joins never pass through each other
+        (:mod:`foldcore.contact`; strategies with ``supports_contact``: ``rigid``).
     """
 
     fold_percent: float = 100.0
@@ -113,9 +117,13 @@ class Solving:
     actuation: str = DEFAULT_ACTUATION
     branch_floor: float = BRANCH_FLOOR_DEG
     strategy_options: object = None
+    contact: str = "off"
 
     def __post_init__(self):
         _within(self.fold_percent, -100.0, 100.0, "solving.fold_percent")
+        if self.contact not in CONTACT_CHOICES:
+            raise OptionError(f"solving.contact must be one of {', '.join(CONTACT_CHOICES)}, "
+                              f"got {self.contact!r}")
         _positive(self.tolerance, "solving.tolerance", optional=False)
         _count(self.max_iterations, 1, None, "solving.max_iterations")
         if self.actuation not in ACTUATIONS:
@@ -203,6 +211,7 @@ FLAGS = {
     "solving.max_iterations": "--max-iterations",
     "solving.actuation": "--actuation",
     "solving.branch_floor": "--branch-floor",
+    "solving.contact": "--contact",
     "outputs.fold": "-o",
     "outputs.report": "--report",
     "outputs.render": "--render",

@@ -116,8 +116,16 @@ def run_summary(result, pattern, source: str, fold_percent: float,
         warns.append(f"{source}: no crease is driven (no target angles): the sheet stays "
                      "as it is; give edges_foldAngle, or M/V creases without angles "
                      "(and not reading.mv_without_angle='passive')")
-    elif entries["binding"]:
-        missed, wrong = entries["missed"], entries["wrong_side"]
+    if entries["contact_blocked"]:
+        blocked = entries["contact_blocked"]
+        gap = result.contact["smallest_gap_mm"]
+        warns.append(f"{source}: contact stops {len(blocked)} of {driven} driven creases short "
+                     f"of their targets (edges {', '.join(map(str, blocked[:10]))}"
+                     + (", …" if len(blocked) > 10 else "") + "): their panels touch "
+                     f"others (smallest gap {gap:.3g} mm); the report's contact section "
+                     "lists the touching panels and their forces")
+    if driven and entries["binding"]:
+        missed, wrong = entries["missed"] - len(entries["contact_blocked"]), entries["wrong_side"]
         warns.append(f"{source}: converged, but {missed} of {driven} driven creases miss "
                      f"their targets by more than {MISS_WARNING_DEG:g}° (up to {worst:.3g}°"
                      + (f"; {wrong} folded to the other side" if wrong else "") + "): "
@@ -143,18 +151,25 @@ def actuation_entries(result, pattern) -> dict:
         else np.array(pattern.fold_angles, dtype=float)
     driven = np.flatnonzero(np.isfinite(targets))
     miss = wrapped_deg(result.fold_angles_deg[driven] - targets[driven])
+    is_missed = np.abs(miss) > MISS_WARNING_DEG
+    touching = set((result.contact or {}).get("touching_faces", []))
+    by_contact = np.array([bool(touching & set(int(f) for f in pattern.edge_faces[e] if f >= 0))
+                           for e in driven], dtype=bool) & is_missed & bool(result.converged)
+    stopped = np.where(by_contact, "contact",
+                       np.where(is_missed & bool(result.converged), "binding", None))
     creases = [{"edge": int(e), "target_deg": float(t), "achieved_deg": float(a),
-                "miss_deg": float(m)}
-               for e, t, a, m in zip(driven, targets[driven], result.fold_angles_deg[driven],
-                                     miss)]
+                "miss_deg": float(m), "stopped_by": s}
+               for e, t, a, m, s in zip(driven, targets[driven],
+                                        result.fold_angles_deg[driven], miss, stopped)]
     worst = float(np.abs(miss).max()) if len(miss) else 0.0
-    missed = int(np.count_nonzero(np.abs(miss) > MISS_WARNING_DEG))
+    missed = int(np.count_nonzero(is_missed))
     wrong = np.sign(targets[driven]) * result.fold_angles_deg[driven] < -MISS_WARNING_DEG
     return {"creases": creases, "largest_miss_deg": worst,
             "median_miss_deg": float(np.median(np.abs(miss))) if len(miss) else 0.0,
             "missed": missed, "miss_tolerance_deg": MISS_WARNING_DEG,
             "wrong_side": int(np.count_nonzero(wrong)),
-            "binding": bool(result.converged and missed > 0)}
+            "contact_blocked": driven[by_contact].tolist(),
+            "binding": bool(result.converged and missed > int(by_contact.sum()))}
 
 
 def hinge_entries(result, pattern, mesh) -> dict:
@@ -209,6 +224,7 @@ def report_dict(result, pattern, mesh, settings: dict, quantities: dict | None =
                                        else pattern.fold_angles),
         "actuation": actuation_entries(result, pattern),
         "hinges": hinge_entries(result, pattern, mesh),
+        **({"contact": result.contact} if result.contact is not None else {}),
         "strip_angles_deg": result.strip_angles_deg.tolist(),
         **_strain_entries(result),
         "vertices": int(mesh.n_vertices),

@@ -42,6 +42,12 @@ class Result:
         a snapshot taken outside a run
     residual : float, the estimated distance to the equilibrium at the end,
         relative to the pattern size (NaN if never measured in the run)
+    contact : dict or None, what contact did at the end (None: contact off):
+        ``active_pairs`` (pattern faces of every pair of panels within the
+        barrier's reach), ``smallest_gap_mm``, ``activation_mm`` (d̂),
+        ``stiffness`` (κ, mm³), ``touching_faces`` and ``panel_forces``
+        (per touching panel its face and the contact force, −∂(κ Σ b)/∂x summed
+        over its vertices, mm⁴)
     """
 
     positions: np.ndarray
@@ -57,3 +63,4 @@ class Result:
     hinge_misfit_mm: np.ndarray | None = None
     reason: str = "none"
     residual: float = float("nan")
+    contact: dict | None = None

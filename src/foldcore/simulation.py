@@ -81,7 +81,7 @@ class Simulation:
                  threads: int | None = None, strain_limits=None,
                  actuation: str = DEFAULT_ACTUATION,
                  branch_floor_deg: float = BRANCH_FLOOR_DEG, options=None,
-                 convergence=ConvergenceTest):
+                 convergence=ConvergenceTest, contact=None):
         start = time.perf_counter()
         try:
             strategy = strategies.get(solver)
@@ -101,6 +101,7 @@ class Simulation:
         self.model.timings["setup"] = time.perf_counter() - start
         self.convergence = convergence(self.model, self.progress)
         self._monitor = self._failure_monitor(strain_limits)
+        self.model.contact = contact_model(self.model, strategy, contact)
         self._bare_solve = None  # (K version, seconds) of the last bare-solve timing
         self.strategy = strategy(self.model, self.progress, options)  # moves model.x
         self.model.subscribe(self._targets_changed)
@@ -392,7 +393,7 @@ class Simulation:
                       list(self._monitor.failures) if self._monitor is not None else [],
                       model.target_angles(), model.hinge_misfits(),
                       reason or ("converged" if converged else "none"),
-                      float(self.convergence.residual))
+                      float(self.convergence.residual), contact_summary(model))
 
     @property
     def failures(self) -> list:
@@ -418,3 +419,46 @@ class Simulation:
                                   self.model.mesh.segments)
         except ValueError as exc:
             raise SimulationError(str(exc)) from None
+
+
+def contact_model(model, strategy, contact):
+    """The :class:`foldcore.contact.ContactModel` ``contact`` asks for (None, False:
+    none; True: default settings; a :class:`foldcore.contact.ContactSettings`)."""
+    if contact is None or contact is False:
+        return None
+    from .contact import ContactModel, ContactSettings
+
+    settings = ContactSettings() if contact is True else contact
+    if not isinstance(settings, ContactSettings):
+        raise SimulationError(f"contact must be True, False or a "
+                              f"foldcore.contact.ContactSettings, got {contact!r}")
+    if not strategy.supports_contact:
+        supported = [name for name in strategies.available()
+                     if strategies.get(name).supports_contact]
+        raise SimulationError(f"solver {strategy.name!r} does not keep panels apart; "
+                              f"contact needs one of {supported}")
+    if not model.mesh.thickness > 0:
+        raise SimulationError("contact needs a sheet of thickness > 0")
+    try:
+        return ContactModel(model.mesh, model.pattern, model.system.reference_weight, settings)
+    except ImportError:
+        raise SimulationError("contact needs the ipctk package: pip install 'foldcore[contact]'") \
+            from None
+
+
+def contact_summary(model) -> dict | None:
+    """:attr:`Result.contact` at the model's positions (None without contact)."""
+    contact = model.contact
+    if contact is None:
+        return None
+    state = contact.state(model.x)
+    face = model.mesh.groups[model.mesh.panel_group].source
+    forces = contact.forces(state)
+    touching = np.unique(state.pairs) if len(state.pairs) else np.zeros(0, dtype=np.int64)
+    return {"active_pairs": face[state.pairs].tolist(),
+            "smallest_gap_mm": float(state.gaps.min()) if len(state.gaps) else None,
+            "activation_mm": contact.dhat, "stiffness": contact.kappa,
+            "touching_faces": face[touching].tolist(),
+            "panel_forces": [{"face": int(face[p]), "force": forces[p].tolist(),
+                              "magnitude": float(np.linalg.norm(forces[p]))}
+                             for p in touching]}

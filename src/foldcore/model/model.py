@@ -91,6 +91,7 @@ class Model:
         self.pins = Pins(self.system, mesh.n_vertices)
         self.length_scale = float(np.ptp(pattern.vertices, axis=0).max())
         self.timings = {"setup": 0.0, "projection": 0.0, "solve": 0.0}
+        self.contact = None  # a foldcore.contact.ContactModel where panels must not cross
         self._subscribers = []
         self._scratch = False  # True while a probe projects (no stop changes)
         self._last_fold_angles = None  # (positions, angles) of the last fold_angles call

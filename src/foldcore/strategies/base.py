@@ -46,6 +46,7 @@ class Strategy:
     #: measures: a run that cannot reach the equilibrium within its budget at that
     #: rate then ends at once, ``stalled``.
     plain_map: bool = False
+    supports_contact: bool = False  # its steps keep panels apart (``model.contact``)
     Options = NoOptions
 
     def __init_subclass__(cls, **kwargs):

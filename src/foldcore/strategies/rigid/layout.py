@@ -67,6 +67,7 @@ class UnknownLayout:
         self.pinned = False
         self.ready = False  # the column blocks exist (build_columns)
         self.version = 0  # patterns of the normal matrix built so far (a factor's key)
+        self.contact_pairs = np.zeros((0, 2), dtype=np.int64)  # panel pairs in the pattern
 
     # ----------------------------------------------------------- structure
     def _init_panels(self, panels, mesh) -> None:
@@ -274,19 +275,38 @@ class UnknownLayout:
         cols[rows[on], self.off_phi[on]] = self.phi_col + fold_of[on]
         self.loc_cols, self.loc_kind = cols, kind
 
+    def add_contact_pairs(self, pairs: np.ndarray) -> bool:
+        """Make room in the normal matrix for panel pairs (K, 2) that touch; True
+        when the pattern grew (a new symbolic analysis follows). Pairs stay once
+        added: a contact that opens and closes again costs one analysis."""
+        code = lambda p: p[:, 0] * self.n_panels + p[:, 1]  # noqa: E731
+        new = pairs[~np.isin(code(pairs), code(self.contact_pairs))]
+        if not len(new):
+            return False
+        self.contact_pairs = np.vstack([self.contact_pairs, new])
+        if self.ready:
+            self._normal_pattern()
+        return True
+
     def _normal_pattern(self) -> None:
         """Fixed CSC pattern of JᵀJ (:mod:`.normal`'s docstring): indptr, indices and
         the slot of each diagonal entry. Blocks beside the strips': each moving
         panel's 6 × 6 block (position targets), each M/V crease's two panel
-        rotations; every column's diagonal comes first in its column."""
+        rotations, each touching panel pair's two panels (contact); every
+        column's diagonal comes first in its column."""
         n = self.n_unknowns
         width = normal.MAX_LOCAL
         panel = self.panel_col[self.panel_col >= 0]
         left, right = self.panel_col[self.mv_left], self.panel_col[self.mv_right]
         both = (left >= 0) & (right >= 0)
+        first, second = self.panel_col[self.contact_pairs].T
+        both_move = (first >= 0) & (second >= 0)
         blocks = [(panel[:, None] + np.arange(6), 6),
                   (np.column_stack([left[both, None] + np.arange(3),
-                                    right[both, None] + np.arange(3)]), 6)]
+                                    right[both, None] + np.arange(3)]), 6),
+                  (np.sort(np.column_stack([first[both_move, None] + np.arange(6),
+                                            second[both_move, None] + np.arange(6)]),
+                           axis=1), 12)]
         cols, n_loc, kind = [self.loc_cols], [self.n_loc], [self.loc_kind]
         for block, size in blocks:
             padded = np.full((len(block), width), -1, dtype=np.int64)

@@ -69,6 +69,7 @@ class ResidualModel:
         self._shape_scratch = np.zeros((8 * s, 3))
         self._shape_phi, self._d_shape_current = np.zeros(s), False
         self._init_mv_rows(model.mesh, model.pattern, options.mv_stiffness)
+        self._contact_at = None  # (positions, ContactState) of the last contact evaluation
 
     def sync_weights(self) -> None:
         """√w from the model's current strip weights (a new array is the sign of a change)."""
@@ -161,12 +162,41 @@ class ResidualModel:
         return value, grad
 
     def trial_energy(self, state) -> float:
-        """Energy of a trial state after refitting its strips' rotations in place."""
+        """Energy of a trial state after refitting its strips' rotations in place
+        (with contact, plus the barrier energy of its panels)."""
         self.update_shapes(state.phi)
         self.fit_rotations(state.x, state.rot_e)
         residual = self.residuals_at_shapes(state)
         strips = 24 * len(self.layout.ids)  # summed as before: the accept test is at rounding level
-        return float((residual[:strips] ** 2).sum() + (residual[strips:] ** 2).sum())
+        energy = float((residual[:strips] ** 2).sum() + (residual[strips:] ** 2).sum())
+        contact = self.contact_state(state.x)
+        return energy if contact is None else energy + contact.energy
+
+    # ------------------------------------------------------------- contact
+    def contact_state(self, x: np.ndarray):
+        """The model's contacts at positions x (cached for the last x), or None
+        without contact."""
+        contact = self.model.contact
+        if contact is None:
+            return None
+        if self._contact_at is None or not np.array_equal(self._contact_at[0], x):
+            self._contact_at = (x.copy(), contact.state(x))
+        return self._contact_at[1]
+
+    def contact_terms(self, state, with_hessian: bool):
+        """(½ Pᵀ∇C (n_q,), lower triangle of ½ PᵀHP as COO or None) of the contact
+        energy C at a state, P = ∂x/∂(panel, free-vertex unknowns); None when
+        nothing touches. ½: the step's energy is rᵀr, its gradient Jᵀr."""
+        contact = self.contact_state(state.x)
+        if contact is None or not len(contact.pairs):
+            return None
+        model = self.model.contact
+        p_map = self.kinematics.position_map(state)
+        grad = 0.5 * (p_map.T @ model.gradient(contact).ravel())
+        if not with_hessian:
+            return grad, None
+        hess = model.hessian(contact)
+        return grad, sp.tril(0.5 * (p_map.T @ (hess @ p_map)), format="coo")
 
     def rounding_energy(self) -> float:
         """Energy of strip residuals of ``ROUNDING`` × the pattern's size in every row
@@ -238,6 +268,10 @@ class ResidualModel:
         s = len(lay.ids)
         lin = Linearisation(lay, self.sqrt_w, state, residual, self.strip_targets,
                             self.angle_columns(state.rot_e), self.extra_rows(state))
+        contact = self.contact_state(state.x)
+        if contact is not None and len(contact.pairs):
+            lay.add_contact_pairs(contact.pairs)
+            lin.contact_energy = contact.energy
         data = np.zeros(len(lay.csc_indices))
         lin.grad = np.zeros(lay.n_unknowns)
         missing = normal.assemble(
@@ -246,6 +280,13 @@ class ResidualModel:
         if lin.extra is not None and lin.extra.nnz:  # (all zero: adds nothing)
             lin.grad += lin.extra.T @ residual[24 * s:]
             coo = sp.tril(lin.extra.T @ lin.extra, format="coo")  # the stored triangle
+            missing += normal.add_entries(lay.csc_indptr, lay.csc_indices, data,
+                                          coo.row.astype(np.int64), coo.col.astype(np.int64),
+                                          coo.data)
+        terms = self.contact_terms(state, with_hessian=True)
+        if terms is not None:
+            grad, coo = terms
+            lin.grad[:len(grad)] += grad
             missing += normal.add_entries(lay.csc_indptr, lay.csc_indices, data,
                                           coo.row.astype(np.int64), coo.col.astype(np.int64),
                                           coo.data)
@@ -260,7 +301,11 @@ class ResidualModel:
         targets it set are used); no normal matrix is assembled."""
         here = Linearisation(self.layout, self.sqrt_w, state, residual, self.strip_targets,
                              self.angle_columns(state.rot_e), self.extra_rows(state))
-        return here.apply_transpose(residual)
+        grad = here.apply_transpose(residual)
+        terms = self.contact_terms(state, with_hessian=False)
+        if terms is not None:
+            grad[:len(terms[0])] += terms[0]
+        return grad
 
 
 class Linearisation:
@@ -275,6 +320,7 @@ class Linearisation:
         self.residual, self.extra = residual, extra
         self.n_strip_rows = 24 * len(layout.ids)
         self.n_unknowns = layout.n_unknowns
+        self.contact_energy = 0.0  # barrier energy at the state, mm⁵ (0 without contact)
         self.strip_args = (layout.ids, state.x, state.c_p, layout.strip_side, layout.off_panel,
                            layout.strip_alpha, layout.own_off, layout.off_w, layout.off_phi,
                            layout.loc_cols, sqrt_w, targets, d_targets)

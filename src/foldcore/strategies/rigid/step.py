@@ -8,7 +8,9 @@ Sethna, "Improvements to the Levenberg–Marquardt algorithm", 2012), keeps it
 only if the energy decreases (or, at rounding level, if it came closer:
 :meth:`LevenbergMarquardt.closer_within_rounding`), tries the end of a
 geometric tail of aligned steps (:meth:`LevenbergMarquardt.extrapolated`),
-and updates λ by the gain ratio (Nielsen's rule). Why each part:
+and updates λ by the gain ratio (Nielsen's rule). With contact every trial
+is shortened until no panel crosses another on the way to it
+(:meth:`LevenbergMarquardt.collision_free`). Why each part:
 `docs/architecture.md#the-rigid-body-strategy`. Units: mm, rad.
 """
 from __future__ import annotations
@@ -19,12 +21,13 @@ import time
 import numpy as np
 import scipy.sparse as sp
 
-from ...linsolve import Factor
+from ...linsolve import Factor, not_positive_definite
 from .residual import ROUNDING
 
 log = logging.getLogger(__name__)
 
 BOUND_TOL = 1e-12  # rad: a bounded angle this close to its bound is on it
+MAX_CUTS = 30  # shortenings of one step toward a contact before it is not taken
 
 
 class LevenbergMarquardt:
@@ -105,12 +108,12 @@ class LevenbergMarquardt:
         start = engine.state()
         lin = residual_model.linearise(start)
         res, grad = lin.residual, lin.grad
-        energy = float(res @ res)
+        energy = float(res @ res) + lin.contact_energy
         t0 = time.perf_counter()
         factor = self._factor(lin.normal, grad)
         velocity = factor.solve(-grad)
         self.solve_time += time.perf_counter() - t0
-        trial = kin.apply(start, velocity, engine.lo, engine.hi)
+        trial, velocity = self.collision_free(start, velocity)
         j_velocity = lin.apply(velocity)
         if o.geodesic_max > 0:  # geodesic acceleration (Transtrum & Sethna 2012)
             h = o.geodesic_h
@@ -119,7 +122,9 @@ class LevenbergMarquardt:
             r_vv = 2.0 / h * ((res_h - res) / h - j_velocity)
             accel = self.solve(-lin.apply_transpose(r_vv))
             if np.linalg.norm(accel) <= o.geodesic_max * np.linalg.norm(velocity):
-                trial = kin.apply(start, velocity + 0.5 * accel, engine.lo, engine.hi)
+                accelerated = kin.apply(start, velocity + 0.5 * accel, engine.lo, engine.hi)
+                if self.crosses(start, accelerated) is None:
+                    trial = accelerated
         moved = float(np.abs(trial.x - engine.x).max())
         new_energy = residual_model.trial_energy(trial)
         self.accepted, self.step_lam = new_energy <= energy, self.lam
@@ -141,6 +146,32 @@ class LevenbergMarquardt:
         self.energy_after = new_energy if self.accepted else energy  # not E − decrease: that
         #   rounds to 0 where the step took E from 1.9e-7 to 8e-24
         return energy, moved
+
+    def crosses(self, start, trial) -> float | None:
+        """None when the straight-line motion from ``start`` to ``trial`` brings no two
+        panels into contact (always, without contact); else the collision-free
+        fraction of it (< 1)."""
+        contact = self.engine.model.contact
+        if contact is None:
+            return None
+        fraction = contact.free_fraction(start.x, trial.x)
+        return None if fraction >= 1.0 else fraction
+
+    def collision_free(self, start, velocity):
+        """(trial, velocity): the step ``velocity`` from ``start``, shortened until
+        the straight-line motion of every vertex to the trial crosses no panel
+        (IPC's CCD-bounded step; without contact the step as it is). The trial's
+        rotations make the motion not quite straight, so each shortened trial is
+        checked again."""
+        engine = self.engine
+        trial = engine.kinematics.apply(start, velocity, engine.lo, engine.hi)
+        for _ in range(MAX_CUTS):
+            fraction = self.crosses(start, trial)
+            if fraction is None:
+                return trial, velocity
+            velocity = velocity * fraction
+            trial = engine.kinematics.apply(start, velocity, engine.lo, engine.hi)
+        return engine.kinematics.apply(start, 0.0 * velocity, engine.lo, engine.hi), 0.0 * velocity
 
     def _rate(self, unresolved, energy, new_energy, grad, velocity, j_velocity) -> None:
         """The step's gain ratio and damped share from the model's predicted decrease
@@ -212,7 +243,8 @@ class LevenbergMarquardt:
             return trial, energy, False
         far = engine.kinematics.apply(start, min(1.0 / (1.0 - ratio), o.extrapolate_max)
                                       * velocity, engine.lo, engine.hi)
-        far_energy = engine.residual.trial_energy(far)
+        far_energy = engine.residual.trial_energy(far) if self.crosses(start, far) is None \
+            else np.inf
         if far_energy < energy:
             self.slow_ratio = max(self.slow_ratio, ratio)
             return far, far_energy, True
@@ -244,9 +276,23 @@ class LevenbergMarquardt:
         g_fold = grad[lay.phi_col:]
         blocked = ((folds <= engine.lo + BOUND_TOL) & (g_fold > 0)) | \
                   ((folds >= engine.hi - BOUND_TOL) & (g_fold < 0))
-        damping = self.lam * diag
-        damping[lay.phi_col:][blocked] = 1e12 * diag[lay.phi_col:][blocked]
-        normal[lay.diag_slot] += damping  # in place: the step needs the undamped no more
+        undamped = normal[lay.diag_slot].copy()
+        while True:
+            damping = self.lam * diag
+            damping[lay.phi_col:][blocked] = 1e12 * diag[lay.phi_col:][blocked]
+            normal[lay.diag_slot] = undamped + damping  # in place: the step needs no more
+            try:
+                return self._factorised(normal)
+            except not_positive_definite():
+                # rounding in a matrix whose contact terms span many decades: more damping
+                if self.lam >= self.options.lambda_max:
+                    raise
+                log.debug("rigid: normal matrix not positive definite at λ %.3g: raised", self.lam)
+                self.lam = min(self.lam * self.options.lambda_up, self.options.lambda_max)
+
+    def _factorised(self, normal: np.ndarray) -> Factor:
+        """The factor of the damped normal matrix (values on the layout's pattern)."""
+        engine, lay = self.engine, self.engine.layout
         n = lay.n_unknowns
         matrix = sp.csc_matrix((normal, lay.csc_indices, lay.csc_indptr), shape=(n, n))
         if self.factor is None or self._pattern != lay.version:

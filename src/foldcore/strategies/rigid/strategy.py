@@ -47,6 +47,7 @@ class Rigid(Strategy):
 
     name = "rigid"
     Options = RigidOptions
+    supports_contact = True
 
     def __init__(self, model, progress, options=None):
         super().__init__(model, progress, options)
@@ -130,7 +131,9 @@ class Rigid(Strategy):
 
     def _coarse_twin(self):
         """The mesh's coarse twin (:class:`.twin.Twin`), built once; None where there
-        is none."""
+        is none, and with contact (the twin's panels would fold without it)."""
+        if self.model.contact is not None:
+            return None
         if self._twin is None:
             from .twin import Twin, twin_mesh
 

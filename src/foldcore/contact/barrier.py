@@ -1,0 +1,275 @@
+"""Contact between panels: IPC's barrier potential and continuous collision detection.
+
+Geometry comes from the IPC Toolkit (``ipctk``, Li et al., "Incremental
+Potential Contact", 2020): its point–triangle and edge–edge distances, the
+log barrier b(d) that is zero from the activation distance d̂ on and grows
+without bound as d → 0, its gradient and PSD-projected Hessian, and a
+conservative continuous collision check (additive CCD) that bounds how far a
+straight-line step may go before any two triangles meet. foldcore's own part
+is which pairs to ask it about (:class:`~.solids.PanelSolids`): only pairs of
+panels the broad phase cannot prove apart, each as a two-body collision mesh
+(cached), so a sheet with nothing near costs a box test and a slab test per
+step. Why ipctk and why panel pairs: `docs/architecture.md#contact`.
+
+Units: positions mm; the contact energy κ Σ b is in the model's energy unit
+(mm⁵, the strips' weighted squared distances), its gradient (the contact
+force, with the sign reversed) in mm⁴.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+
+from .solids import PanelSolids
+
+#: Share of a straight-line step taken up to the first touch (IPC's 0.8–0.9).
+CCD_RESCALING = 0.9
+#: Joined panels touch with their geometry scaled by 1 − this about its centroid
+#: (:meth:`~.solids.PanelSolids.shrunk`): faces that meet by design stay apart, and
+#: two joined panels can overlap by at most this share of their size.
+JOINED_SHARE = 2e-5
+
+
+def _ipctk():
+    import ipctk  # an import only runs that ask for contact pay for
+
+    return ipctk
+
+
+@dataclass(frozen=True)
+class ContactSettings:
+    """How panels touch.
+
+    Attributes
+    ----------
+    activation : float
+        d̂ relative to the sheet thickness H: the barrier acts on pairs closer than
+        activation · H (default 0.01: 1 % of H).
+    stiffness : float
+        κ relative to the model's reference weight (dimensionless factor).
+    """
+
+    activation: float = 0.01
+    stiffness: float = 1.0
+
+    def __post_init__(self):
+        for name in ("activation", "stiffness"):
+            value = getattr(self, name)
+            if not (isinstance(value, (int, float)) and np.isfinite(value) and value > 0):
+                raise ValueError(f"contact.{name} must be a finite number > 0, got {value!r}")
+
+
+@dataclass
+class ContactState:
+    """The contacts at one set of positions.
+
+    Attributes
+    ----------
+    pairs : (K, 2) int
+        Panel pairs with at least one primitive pair within d̂.
+    gaps : (K,) float
+        Each pair's smallest distance, mm.
+    energy : float
+        κ Σ b over every active primitive pair, mm⁵.
+    """
+
+    pairs: np.ndarray
+    gaps: np.ndarray
+    energy: float
+    _terms: list  # (pair vertices (n,), collisions, collision mesh, local positions)
+
+
+class ContactModel:
+    """Barrier energy, its derivatives and collision-free step fractions of a mesh's
+    rigid panels.
+
+    Parameters
+    ----------
+    mesh, pattern
+        The thick mesh and its crease pattern.
+    reference_weight : float
+        The model's reference weight (mm³): κ = ``settings.stiffness`` × it.
+    settings : ContactSettings
+    """
+
+    def __init__(self, mesh, pattern, reference_weight: float,
+                 settings: ContactSettings | None = None):
+        self.settings = settings or ContactSettings()
+        self.solids = PanelSolids(mesh, pattern)
+        self.dhat = self.settings.activation * float(mesh.thickness)
+        self.kappa = self.settings.stiffness * float(reference_weight)
+        #: d̂ of joined pairs, mm: half the gap their shrunk faces keep at a flat fold
+        self.dhat_joined = 0.5 * JOINED_SHARE * float(mesh.thickness)
+        self.n_vertices = mesh.n_vertices
+        self._rest = mesh.rest_positions
+        self._meshes: dict = {}
+        ipctk = _ipctk()
+        self._potential = {
+            False: ipctk.BarrierPotential(self.dhat, self.kappa),
+            # κ × d̂/d̂_j: a force at a gap of d̂_j/2 as large as κ's at d̂/2 … within a
+            # factor ln: of the variants tried (×1, ×d̂/d̂_j, ×(d̂/d̂_j)²) the fewest steps
+            True: ipctk.BarrierPotential(self.dhat_joined,
+                                         self.kappa * self.dhat / self.dhat_joined)}
+        self._ccd = ipctk.AdditiveCCD(conservative_rescaling=CCD_RESCALING)
+
+    # -------------------------------------------------------------- pairs
+    def candidates(self, x: np.ndarray, margin: float) -> np.ndarray:
+        """(K, 2) unjoined panel pairs not proved farther apart than ``margin`` mm."""
+        lo, hi = self.solids.boxes(x)
+        pairs = self.solids.pairs_near(lo, hi, margin)
+        if len(pairs):
+            pairs = pairs[self.solids.gap_bounds(x, pairs) < margin]
+        return pairs
+
+    def _joined_near(self, shrunk: np.ndarray, margin: np.ndarray | float) -> np.ndarray:
+        """(K, 2) joined pairs whose shrunk panels are not proved ``margin`` apart."""
+        pairs = self.solids.joined_pairs
+        if not len(pairs):
+            return pairs
+        return pairs[self.solids.gap_bounds(shrunk, pairs, self.solids.joined_edge) < margin]
+
+    def _pairs(self, x: np.ndarray):
+        """[(joined, pairs, positions)] to evaluate at x: unjoined pairs within d̂ on
+        the panels as they are, joined pairs within their d̂ on the shrunk panels."""
+        shrunk = self.solids.shrunk(x, JOINED_SHARE)
+        return [(False, self.candidates(x, self.dhat), x),
+                (True, self._joined_near(shrunk, self.dhat_joined), shrunk)]
+
+    def _pair_mesh(self, a: int, b: int, joined: bool):
+        """(collision mesh, model vertex ids, pull-back) of panels a and b, cached; the
+        pull-back maps the pair's (3n,) dofs of its (shrunk) geometry to x (None:
+        the identity)."""
+        key = (a, b)
+        if key not in self._meshes:
+            ipctk = _ipctk()
+            s = self.solids
+            ids = s.pair_vertices(a, b)
+            n_a = s.ptr[a + 1] - s.ptr[a]
+            faces = np.vstack([s.triangles[a], s.triangles[b] + n_a]).astype(np.int32)
+            mesh = ipctk.CollisionMesh(np.asfortranarray(self._rest[ids]),
+                                       ipctk.edges(faces), faces)
+            mesh.can_collide = ipctk.make_vertex_patches_filter(
+                np.repeat([0, 1], [n_a, len(ids) - n_a]).astype(np.int32))
+            self._meshes[key] = (mesh, ids, _shrink_map(n_a, len(ids) - n_a)
+                                 if joined else None)
+        return self._meshes[key]
+
+    # -------------------------------------------------------- the barrier
+    def state(self, x: np.ndarray) -> ContactState:
+        """The contacts at positions x (N, 3)."""
+        ipctk = _ipctk()
+        pairs, gaps, energy, terms = [], [], 0.0, []
+        for joined, candidates, positions in self._pairs(x):
+            dhat, potential = (self.dhat_joined if joined else self.dhat), self._potential[joined]
+            for a, b in candidates:
+                mesh, ids, pull = self._pair_mesh(int(a), int(b), joined)
+                local = np.asfortranarray(positions[ids])
+                collisions = ipctk.NormalCollisions()
+                collisions.build(mesh, local, dhat)
+                if not len(collisions):
+                    continue
+                pairs.append((a, b))
+                gaps.append(np.sqrt(collisions.compute_minimum_distance(mesh, local)))
+                energy += float(potential(collisions, mesh, local))
+                terms.append((ids, collisions, mesh, local, potential, pull))
+        pairs = np.array(pairs, dtype=np.int64).reshape(-1, 2)
+        return ContactState(pairs, np.array(gaps, dtype=float), energy, terms)
+
+    def energy(self, x: np.ndarray) -> float:
+        """κ Σ b at positions x, mm⁵ (finite at every state a step reaches: each step
+        is cut short of a touch by :meth:`free_fraction`)."""
+        return self.state(x).energy
+
+    def gradient(self, state: ContactState) -> np.ndarray:
+        """(N, 3) ∂(κ Σ b)/∂x at a state's positions, mm⁴."""
+        out = np.zeros((self.n_vertices, 3))
+        for ids, collisions, mesh, local, potential, pull in state._terms:
+            g = potential.gradient(collisions, mesh, local)
+            out[ids] += (g if pull is None else pull.T @ g).reshape(-1, 3)
+        return out
+
+    def hessian(self, state: ContactState) -> sp.csr_matrix:
+        """(3N, 3N) PSD-projected ∂²(κ Σ b)/∂x², mm³ (each pair's block clamped)."""
+        ipctk = _ipctk()
+        rows, cols, vals = [], [], []
+        for ids, collisions, mesh, local, potential, pull in state._terms:
+            block = potential.hessian(collisions, mesh, local, ipctk.PSDProjectionMethod.CLAMP)
+            if pull is not None:
+                block = sp.coo_matrix(pull.T @ block.toarray() @ pull)
+            block = block.tocoo()
+            dof = (3 * ids[:, None] + np.arange(3)).ravel()
+            rows.append(dof[block.row])
+            cols.append(dof[block.col])
+            vals.append(block.data)
+        n = 3 * self.n_vertices
+        if not rows:
+            return sp.csr_matrix((n, n))
+        return sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows),
+                                                     np.concatenate(cols))), shape=(n, n))
+
+    # ------------------------------------------------------------- steps
+    def free_fraction(self, x0: np.ndarray, x1: np.ndarray) -> float:
+        """A share t ∈ [0, 1] of the step x0 → x1 that brings no two panels into
+        contact; 1 where nothing comes near. x0 must be intersection-free.
+
+        Unjoined pairs: the largest t for which the straight-line motion
+        x0 → x0 + t (x1 − x0) is collision-free (additive CCD, rescaled by
+        ``CCD_RESCALING``). Joined pairs turn about the hinge they share, whose
+        chords cut across it, so a straight-line check would stop them where the
+        hinge keeps their faces a hair apart; their shrunk geometry is checked
+        at x1 instead (½ where it intersects): two panels a hinge joins cannot
+        pass through each other without intersecting on the way, and a step is
+        a small turn of that hinge."""
+        s = self.solids
+        if not s.n_panels:
+            return 1.0
+        lo0, hi0 = s.boxes(x0)
+        lo1, hi1 = s.boxes(x1)
+        pairs = s.pairs_near(np.minimum(lo0, lo1), np.maximum(hi0, hi1), 0.0)
+        if len(pairs):
+            pairs = pairs[s.gap_bounds(x0, pairs, later=x1) <= 0.0]
+        ipctk = _ipctk()
+        fraction = 1.0
+        for a, b in pairs:
+            mesh, ids, _ = self._pair_mesh(int(a), int(b), False)
+            t = ipctk.compute_collision_free_stepsize(
+                mesh, np.asfortranarray(x0[ids]), np.asfortranarray(x1[ids]),
+                narrow_phase_ccd=self._ccd)
+            fraction = min(fraction, float(t))
+        shrunk = s.shrunk(x1, JOINED_SHARE)
+        for a, b in self._joined_near(shrunk, 0.0):
+            mesh, ids, _ = self._pair_mesh(int(a), int(b), True)
+            if ipctk.has_intersections(mesh, np.asfortranarray(shrunk[ids])):
+                return min(fraction, 0.5)
+        return fraction
+
+    def overlapping(self, x: np.ndarray) -> np.ndarray:
+        """(K, 2) unjoined panel pairs whose surfaces intersect at x (a check, not a
+        step's work)."""
+        ipctk = _ipctk()
+        found = []
+        for a, b in self.candidates(x, 0.0):
+            mesh, ids, _ = self._pair_mesh(int(a), int(b), False)
+            if ipctk.has_intersections(mesh, np.asfortranarray(x[ids])):
+                found.append((a, b))
+        return np.array(found, dtype=np.int64).reshape(-1, 2)
+
+    def forces(self, state: ContactState) -> np.ndarray:
+        """(n_panels, 3) contact force on each panel (−Σ of its vertices' barrier
+        gradients), mm⁴."""
+        gradient = self.gradient(state)
+        s = self.solids
+        return -np.add.reduceat(gradient[s.vertices], s.ptr[:-1]) if s.n_panels \
+            else np.zeros((0, 3))
+
+
+def _shrink_map(n_a: int, n_b: int) -> np.ndarray:
+    """(3n, 3n) ∂(shrunk dofs)/∂(dofs) of a joined pair (n = n_a + n_b vertices,
+    vertex-major): per panel (1 − s) I + (s / n_p) 1 1ᵀ, s = ``JOINED_SHARE``."""
+    blocks = [(1.0 - JOINED_SHARE) * np.eye(n) + (JOINED_SHARE / n) * np.ones((n, n))
+              for n in (n_a, n_b)]
+    vertex_map = np.block([[blocks[0], np.zeros((n_a, n_b))],
+                           [np.zeros((n_b, n_a)), blocks[1]]])
+    return np.kron(vertex_map, np.eye(3))

@@ -1,0 +1,230 @@
+"""The solids that touch: every rigid panel's closed prism, which panels are joined,
+and a panel-level broad phase that proves most pairs apart without a narrow phase.
+
+A panel is a prism: its top loop, the same loop H lower, and side quads, all
+vertices its own (the rigid-body layout checks that panels share none). Two
+panels are *joined* when a crease's hinge strip connects them; the hinge
+model keeps those apart, and at a flat fold they touch face to face by design,
+so contact leaves them to it. Every other pair is a contact candidate.
+
+The broad phase has two stages, both vectorised: axis-aligned boxes (within a
+margin), then a separating-axis bound: the gap between the two panels'
+vertex intervals along their normals, the bisectors of those and the line
+between their centroids. That bound
+is a lower bound of the true distance, so a pair it proves farther than the
+margin cannot touch. Units: mm.
+"""
+from __future__ import annotations
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from ..mesh import prism_face_loops
+from ..surface import triangulate_polygons
+
+
+class PanelSolids:
+    """Every rigid panel of a thick mesh as a closed triangulated prism.
+
+    Parameters
+    ----------
+    mesh : foldcore.mesh.ThickMesh
+    pattern : foldcore.pattern.CreasePattern
+
+    Attributes
+    ----------
+    n_panels : int
+    vertices : (n,) int64
+        Model vertex ids of every panel, panel by panel.
+    ptr : (n_panels + 1,) int64
+        Panel p's vertices are ``vertices[ptr[p]:ptr[p + 1]]``.
+    triangles : list of (T_p, 3) int32
+        Each panel's outward surface triangles, indices local to its vertices.
+    joined : (J,) int64
+        Sorted codes a · n_panels + b (a < b) of the panel pairs a crease joins.
+    joined_pairs : (J, 2) int64
+        The joined pairs themselves (a < b).
+    """
+
+    def __init__(self, mesh, pattern):
+        group = mesh.groups.get(mesh.panel_group)
+        self.n_panels = len(group) if group is not None else 0
+        ids = [group.indices[group.slots(p)] for p in range(self.n_panels)]
+        sizes = np.array([len(i) for i in ids], dtype=np.int64)
+        self.vertices = np.concatenate(ids).astype(np.int64) if ids else np.zeros(0, np.int64)
+        self.ptr = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
+        self.panel_of_vertex = np.repeat(np.arange(self.n_panels), sizes)
+        self._init_top_loops(sizes)
+        self.triangles = self._triangles(mesh, ids)
+        self.joined = self._joined(mesh, pattern)
+
+    def _init_top_loops(self, sizes: np.ndarray) -> None:
+        """Each top-loop vertex and the next one in its loop (indices into
+        :attr:`vertices`) and its panel: Newell's normal, vectorised."""
+        half = sizes // 2
+        first = self.ptr[:-1]
+        self._top = _ranges(first, half)
+        owner = np.repeat(np.arange(self.n_panels), half)
+        position = self._top - first[owner]
+        self._top_next = first[owner] + (position + 1) % half[owner]
+        self._top_owner = owner
+
+    def _triangles(self, mesh, ids) -> list:
+        """Outward triangles of each prism, local vertex indices."""
+        n_top = len(mesh.points)
+        caps = []
+        for panel_ids in ids:
+            for loop, is_cap in prism_face_loops(np.arange(len(panel_ids))):
+                if is_cap:
+                    caps.append(mesh.points[panel_ids[loop] % n_top])
+        cap_tris = triangulate_polygons(caps)
+        out = []
+        for p, panel_ids in enumerate(ids):
+            tris = []
+            for loop, is_cap in prism_face_loops(np.arange(len(panel_ids))):
+                tris.append(loop[cap_tris.pop(0)] if is_cap else loop[[[0, 1, 2], [0, 2, 3]]])
+            out.append(np.ascontiguousarray(np.vstack(tris), dtype=np.int32))
+        return out
+
+    def _joined(self, mesh, pattern) -> np.ndarray:
+        creases = np.array(sorted(mesh.strips_of_crease), dtype=np.int64)
+        if not len(creases):
+            self.joined_pairs = np.zeros((0, 2), dtype=np.int64)
+            self.joined_edge = np.zeros((0, 2), dtype=np.int64)
+            return np.zeros(0, dtype=np.int64)
+        left, right = mesh.measuring_panels(pattern, creases)
+        a, b = np.minimum(left, right), np.maximum(left, right)
+        codes, first = np.unique(a * self.n_panels + b, return_index=True)
+        self.joined_pairs = np.column_stack([codes // self.n_panels, codes % self.n_panels])
+        self.joined_edge = self._crease_edges(mesh, pattern, creases[first], a[first])
+        return codes
+
+    def _crease_edges(self, mesh, pattern, creases, panels) -> np.ndarray:
+        """(J, 2) model vertex ids of the top-loop edge of each joined pair's first
+        panel most nearly parallel to the crease joining them: it turns with the
+        panel, and the in-plane normal to it separates the pair while it is
+        (nearly) flat."""
+        rest = mesh.rest_positions[:, :2]
+        ends = pattern.vertices[pattern.edges[creases]]
+        d = ends[:, 1] - ends[:, 0]
+        d /= np.linalg.norm(d, axis=1)[:, None]
+        out = np.zeros((len(creases), 2), dtype=np.int64)
+        for k, p in enumerate(panels):
+            loop = self.vertices[self.ptr[p]:self.ptr[p] + (self.ptr[p + 1] - self.ptr[p]) // 2]
+            edge = rest[np.roll(loop, -1)] - rest[loop]
+            cosine = np.abs(edge @ d[k]) / np.maximum(np.linalg.norm(edge, axis=1), 1e-300)
+            j = int(np.argmax(cosine))
+            out[k] = loop[j], loop[(j + 1) % len(loop)]
+        return out
+
+    # ---------------------------------------------------------- geometry
+    def boxes(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(lo, hi), each (n_panels, 3): every panel's axis-aligned box at positions x."""
+        points = x[self.vertices]
+        start = self.ptr[:-1]
+        return np.minimum.reduceat(points, start), np.maximum.reduceat(points, start)
+
+    def normals(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(normal, mid-plane point), each (n_panels, 3): each panel's unit normal
+        (Newell's, of its top loop) and the centroid of its vertices."""
+        points = x[self.vertices]
+        centre = np.add.reduceat(points, self.ptr[:-1]) / np.diff(self.ptr)[:, None]
+        cross = np.cross(points[self._top], points[self._top_next])
+        n = np.column_stack([np.bincount(self._top_owner, weights=cross[:, k],
+                                         minlength=self.n_panels) for k in range(3)])
+        n /= np.maximum(np.linalg.norm(n, axis=1), 1e-300)[:, None]
+        return n, centre
+
+    def pairs_near(self, lo, hi, margin: float) -> np.ndarray:
+        """(K, 2) panel pairs (a < b), not joined, whose boxes (lo, hi) come within
+        ``margin`` mm of each other."""
+        if self.n_panels < 2:
+            return np.zeros((0, 2), dtype=np.int64)
+        centre, half = 0.5 * (lo + hi), 0.5 * (hi - lo)
+        radius = 2.0 * float(np.linalg.norm(half, axis=1).max()) + 2.0 * margin
+        pairs = cKDTree(centre).query_pairs(radius, output_type="ndarray").astype(np.int64)
+        if not len(pairs):
+            return pairs.reshape(0, 2)
+        pairs.sort(axis=1)
+        a, b = pairs[:, 0], pairs[:, 1]
+        close = (np.abs(centre[a] - centre[b]) <= half[a] + half[b] + margin).all(axis=1)
+        pairs = pairs[close]
+        code = pairs[:, 0] * self.n_panels + pairs[:, 1]
+        return pairs[~np.isin(code, self.joined)]
+
+    def gap_bounds(self, x: np.ndarray, pairs: np.ndarray, edges=None,
+                   later: np.ndarray | None = None) -> np.ndarray:
+        """(K,) a lower bound (mm) of each pair's distance at positions x (≤ 0: not
+        proved apart): the widest gap between the two panels' vertex intervals
+        along any of five axes: the panels' normals, their sum and difference
+        (the bisector planes of two panels hinged together) and the line between
+        their centroids (two panels side by side in one plane); given ``edges``
+        (K, 2) vertex ids of an edge per pair, also the in-plane normals to it
+        (two panels a crease joins, flat). A gap along any axis separates the
+        panels' convex hulls, which contain the panels.
+
+        With ``later`` positions, the bound holds for the whole straight-line
+        motion x → later: along a fixed axis a gap is concave in the motion's
+        parameter, so the smaller of its two end values bounds it."""
+        if not len(pairs):
+            return np.zeros(0)
+        normal, centre = self.normals(x)
+        a, b = pairs[:, 0], pairs[:, 1]
+        axes = [normal[a], normal[b], normal[a] + normal[b], normal[a] - normal[b],
+                centre[b] - centre[a]]
+        if edges is not None:  # joined pairs: in-plane normals to their crease's edge
+            along = x[edges[:, 1]] - x[edges[:, 0]]
+            axes += [np.cross(normal[a], along), np.cross(normal[b], along)]
+        bound = np.full(len(pairs), -np.inf)
+        span_a, span_b = self._gathered(a), self._gathered(b)
+        for axis in axes:
+            length = np.linalg.norm(axis, axis=1)
+            usable = length > 1e-6
+            unit = axis / np.where(usable, length, 1.0)[:, None]
+            gap = np.full(len(pairs), np.inf)
+            for y in (x,) if later is None else (x, later):
+                lo_a, hi_a = self._interval(y, span_a, unit)
+                lo_b, hi_b = self._interval(y, span_b, unit)
+                gap = np.minimum(gap, np.maximum(lo_b - hi_a, lo_a - hi_b))
+            bound = np.maximum(bound, np.where(usable, gap, -np.inf))
+        return bound
+
+    def _gathered(self, panels: np.ndarray):
+        """(vertex ids, pair row of each, start of each pair's run) of the panels."""
+        counts = np.diff(self.ptr)[panels]
+        rows = np.repeat(np.arange(len(panels)), counts)
+        start = np.concatenate([[0], np.cumsum(counts)[:-1]])
+        return self.vertices[_ranges(self.ptr[panels], counts)], rows, start
+
+    @staticmethod
+    def _interval(x, gathered, unit):
+        """(lo, hi) of each pair's panel vertices projected on its unit axis."""
+        verts, rows, start = gathered
+        s = np.einsum("ij,ij->i", x[verts], unit[rows])
+        return np.minimum.reduceat(s, start), np.maximum.reduceat(s, start)
+
+    def shrunk(self, x: np.ndarray, share: float) -> np.ndarray:
+        """(N, 3) x with every panel scaled by 1 − ``share`` about its vertices'
+        centroid (other vertices as they are): the geometry joined panels touch
+        with, so faces that meet by design (a flat fold's inner faces, a pivoting
+        hinge's inner edges) stay ``share`` × their distance from the centroids
+        apart."""
+        out = x.copy()
+        points = x[self.vertices]
+        centre = np.add.reduceat(points, self.ptr[:-1]) / np.diff(self.ptr)[:, None]
+        out[self.vertices] = (1.0 - share) * points + share * centre[self.panel_of_vertex]
+        return out
+
+    def pair_vertices(self, a: int, b: int) -> np.ndarray:
+        """Model vertex ids of panels a then b."""
+        return np.concatenate([self.vertices[self.ptr[a]:self.ptr[a + 1]],
+                               self.vertices[self.ptr[b]:self.ptr[b + 1]]])
+
+
+def _ranges(starts: np.ndarray, counts: np.ndarray) -> np.ndarray:
+    """Concatenated aranges ``start … start + count − 1``, vectorised."""
+    total = int(counts.sum())
+    if not total:
+        return np.zeros(0, dtype=np.int64)
+    offsets = np.repeat(starts - np.concatenate([[0], np.cumsum(counts)[:-1]]), counts)
+    return np.arange(total, dtype=np.int64) + offsets

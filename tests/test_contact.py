@@ -1,0 +1,167 @@
+"""Contact: panels that no crease joins never pass through each other, joined panels
+overlap by at most the shrink their contact geometry allows, a contact that never
+engages changes nothing, and every surface says what contact did.
+
+The letter fold: three panels 6 | 10 | 6 mm wide in a row, both creases valleys
+driven to 180°. Folded flat, the two outer panels land on the middle one from the
+same side and would share the strip 10 … 12 mm: one of them must stop on the
+other. The overlap volumes are measured by tests/solids.py (manifold3d), not by
+foldcore."""
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from itertools import combinations
+
+import numpy as np
+import pytest
+
+pytest.importorskip("ipctk")
+
+from foldcore.contact import ContactSettings  # noqa: E402
+from foldcore.contact.barrier import JOINED_SHARE  # noqa: E402
+from foldcore.errors import SimulationError  # noqa: E402
+from foldcore.options import OptionError, Solving  # noqa: E402
+from foldcore.pattern import CreasePattern  # noqa: E402
+from foldcore.simulation import Simulation  # noqa: E402
+from foldcore.strategies.rigid import RigidOptions  # noqa: E402
+from foldcore.thickening import thicken  # noqa: E402
+from foldcore import patterns  # noqa: E402
+
+from solids import hull  # noqa: E402
+
+H = 1.0  # mm
+#: the acceptance bound: two panels' hulls may share at most this share of a panel
+OVERLAP_SHARE = 1e-4
+
+LETTER = {"file_spec": 1.1, "frame_classes": ["creasePattern"],
+          "vertices_coords": [[0, 0], [6, 0], [16, 0], [22, 0],
+                              [0, 10], [6, 10], [16, 10], [22, 10]],
+          "edges_vertices": [[1, 5], [2, 6], [0, 1], [1, 2], [2, 3], [4, 5], [5, 6], [6, 7],
+                             [0, 4], [3, 7]],
+          "edges_assignment": ["V", "V"] + ["B"] * 8,
+          "edges_foldAngle": [180, 180] + [0] * 8}
+
+
+def letter_pattern() -> CreasePattern:
+    v = np.array(LETTER["vertices_coords"], dtype=float)
+    return CreasePattern(v, np.array(LETTER["edges_vertices"]),
+                         np.array(LETTER["edges_assignment"]), source="letter")
+
+
+def overlap_shares(mesh, positions) -> dict:
+    """{(face a, face b): overlap volume / the smaller panel's volume} of every
+    pair of panel hulls that overlap."""
+    g = mesh.groups[mesh.panel_group]
+    hulls = {int(g.source[p]): hull(positions[g.indices[g.slots(p)]]) for p in range(len(g))}
+    out = {}
+    for a, b in combinations(sorted(hulls), 2):
+        volume = (hulls[a] ^ hulls[b]).volume()
+        if volume > 0:
+            out[(a, b)] = volume / min(hulls[a].volume(), hulls[b].volume())
+    return out
+
+
+def fold_letter(contact):
+    pattern = letter_pattern()
+    mesh = thicken(pattern, H)
+    sim = Simulation(mesh, pattern, solver="rigid", contact=contact)
+    sim.set_fold_angles({0: 180.0, 1: 180.0})
+    return mesh, sim, sim.run(tolerance=1e-8, max_iterations=2_000)
+
+
+@pytest.fixture(scope="module")
+def letter_runs():
+    return {contact: fold_letter(contact) for contact in (False, True)}
+
+
+def test_without_contact_the_outer_panels_pass_through_each_other(letter_runs):
+    mesh, _, result = letter_runs[False]
+    assert overlap_shares(mesh, result.positions)[(0, 2)] > 0.1  # the check can fail
+
+
+def test_with_contact_no_two_panels_overlap(letter_runs):
+    mesh, _, result = letter_runs[True]
+    shares = overlap_shares(mesh, result.positions)
+    assert not shares or max(shares.values()) <= OVERLAP_SHARE, shares
+    # joined panels (1, 2) touch face to face: at most the contact geometry's shrink
+    assert (0, 2) not in shares
+
+
+def test_contact_stops_one_crease_and_lets_the_other_fold_flat(letter_runs):
+    _, _, result = letter_runs[True]
+    assert result.converged
+    assert abs(result.fold_angles_deg[1] - 180.0) < 0.01
+    # panel 0 rests on panel 2's edge: well short of flat (> 1°), on its valley side
+    assert 90.0 < result.fold_angles_deg[0] < 179.0
+    c = result.contact
+    assert c["active_pairs"] and [0, 2] in c["active_pairs"]
+    assert 0.0 <= c["smallest_gap_mm"] < c["activation_mm"]
+    forces = {f["face"]: np.array(f["force"]) for f in c["panel_forces"]}
+    # action and reaction between panels 0 and 2 (panel 1 is pressed by 2 as well)
+    assert forces[0] @ forces[2] < 0
+
+
+def test_a_contact_that_never_engages_changes_nothing():
+    pattern = patterns.miura_one_crease(6, 6, tilt=45.0)
+    mesh = thicken(pattern, H)
+    runs = [Simulation(mesh, pattern, solver="rigid", contact=c,
+                       options=RigidOptions(coarse_start=False)).run(tolerance=1e-8)
+            for c in (False, True)]
+    assert runs[0].iterations == runs[1].iterations
+    assert np.array_equal(runs[0].positions, runs[1].positions)
+    assert runs[1].contact["active_pairs"] == []
+
+
+def test_a_step_through_a_panel_is_cut_short_of_it(letter_runs):
+    mesh, sim, result = letter_runs[True]
+    contact = sim.model.contact
+    x0 = result.positions
+    g = mesh.groups[mesh.panel_group]
+    outer = g.indices[g.slots(0)]
+    normal = np.cross(*(x0[outer[1:3]] - x0[outer[0]]))
+    normal /= np.linalg.norm(normal)
+    fractions = []
+    # 3H along the normal: one way right through panel 2 (both ends free of overlap:
+    # only a continuous check sees the crossing), the other way clear of it
+    for sign in (1.0, -1.0):
+        x1 = x0.copy()
+        x1[outer] += sign * 3 * H * normal
+        t = contact.free_fraction(x0, x1)
+        assert len(contact.overlapping(x0 + t * (x1 - x0))) == 0
+        fractions.append(t)
+    assert min(fractions) < 1.0 and max(fractions) == 1.0
+
+
+def test_joined_panels_keep_their_shrunk_faces_apart():
+    assert 0 < JOINED_SHARE <= OVERLAP_SHARE
+
+
+def test_contact_settings_and_solvers_are_checked():
+    with pytest.raises(ValueError, match="contact.activation"):
+        ContactSettings(activation=0.0)
+    with pytest.raises(OptionError, match="solving.contact"):
+        Solving(contact="maybe")
+    pattern = letter_pattern()
+    with pytest.raises(SimulationError, match="does not keep panels apart"):
+        Simulation(thicken(pattern, H), pattern, solver="paper", contact=True)
+
+
+def test_command_line_contact(tmp_path):
+    path = tmp_path / "letter.fold"
+    path.write_text(json.dumps(LETTER))
+    cli = [sys.executable, "-m", "foldcore", "simulate", str(path), "--thickness", "1",
+           "--contact", "on"]
+    refused = subprocess.run(cli, capture_output=True, text=True)
+    assert refused.returncode == 2 and "Traceback" not in refused.stderr
+    assert "--solver" in refused.stderr or "solver" in refused.stderr
+    done = subprocess.run(cli + ["--solver", "rigid", "--report", str(tmp_path / "r.json"),
+                                 "-o", str(tmp_path / "out.fold")],
+                          capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    assert "contact stops 1 of 2 driven creases" in done.stderr
+    report = json.loads((tmp_path / "r.json").read_text())
+    assert report["settings"]["contact"] == "on"
+    assert report["actuation"]["contact_blocked"] == [0]
+    assert [c["stopped_by"] for c in report["actuation"]["creases"]] == ["contact", None]
