@@ -152,7 +152,7 @@ def actuation_entries(result, pattern) -> dict:
     driven = np.flatnonzero(np.isfinite(targets))
     miss = wrapped_deg(result.fold_angles_deg[driven] - targets[driven])
     is_missed = np.abs(miss) > MISS_WARNING_DEG
-    touching = set((result.contact or {}).get("touching_faces", []))
+    touching = set((getattr(result, "contact", None) or {}).get("touching_faces", []))
     by_contact = np.array([bool(touching & set(int(f) for f in pattern.edge_faces[e] if f >= 0))
                            for e in driven], dtype=bool) & is_missed & bool(result.converged)
     stopped = np.where(by_contact, "contact",
