@@ -98,9 +98,9 @@ def test_contact_stops_one_crease_and_lets_the_other_fold_flat(letter_runs):
     c = result.contact
     assert c["active_pairs"] and [0, 2] in c["active_pairs"]
     assert 0.0 <= c["smallest_gap_mm"] < c["activation_mm"]
-    forces = {f["face"]: np.array(f["force"]) for f in c["panel_forces"]}
-    # action and reaction between panels 0 and 2 (panel 1 is pressed by 2 as well)
-    assert forces[0] @ forces[2] < 0
+    forces = np.array([f["force"] for f in c["panel_forces"]])
+    # contact forces are internal: action and reaction sum to zero over the panels
+    assert np.linalg.norm(forces.sum(axis=0)) <= 1e-6 * np.abs(forces).max()
 
 
 def test_a_contact_that_never_engages_changes_nothing():
