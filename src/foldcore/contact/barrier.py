@@ -177,11 +177,6 @@ class ContactModel:
         pairs = np.array(pairs, dtype=np.int64).reshape(-1, 2)
         return ContactState(pairs, np.array(gaps, dtype=float), energy, terms)
 
-    def energy(self, x: np.ndarray) -> float:
-        """κ Σ b at positions x, mm⁵ (finite at every state a step reaches: each step
-        is cut short of a touch by :meth:`free_fraction`)."""
-        return self.state(x).energy
-
     def gradient(self, state: ContactState) -> np.ndarray:
         """(N, 3) ∂(κ Σ b)/∂x at a state's positions, mm⁴."""
         out = np.zeros((self.n_vertices, 3))

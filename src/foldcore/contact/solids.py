@@ -128,12 +128,16 @@ class PanelSolids:
         """(normal, mid-plane point), each (n_panels, 3): each panel's unit normal
         (Newell's, of its top loop) and the centroid of its vertices."""
         points = x[self.vertices]
-        centre = np.add.reduceat(points, self.ptr[:-1]) / np.diff(self.ptr)[:, None]
+        centre = self._centres(points)
         cross = np.cross(points[self._top], points[self._top_next])
         n = np.column_stack([np.bincount(self._top_owner, weights=cross[:, k],
                                          minlength=self.n_panels) for k in range(3)])
         n /= np.maximum(np.linalg.norm(n, axis=1), 1e-300)[:, None]
         return n, centre
+
+    def _centres(self, points: np.ndarray) -> np.ndarray:
+        """(n_panels, 3) centroid of each panel's vertices, from ``points`` = x[vertices]."""
+        return np.add.reduceat(points, self.ptr[:-1]) / np.diff(self.ptr)[:, None]
 
     def pairs_near(self, lo, hi, margin: float) -> np.ndarray:
         """(K, 2) panel pairs (a < b), not joined, whose boxes (lo, hi) come within
@@ -211,7 +215,7 @@ class PanelSolids:
         apart."""
         out = x.copy()
         points = x[self.vertices]
-        centre = np.add.reduceat(points, self.ptr[:-1]) / np.diff(self.ptr)[:, None]
+        centre = self._centres(points)
         out[self.vertices] = (1.0 - share) * points + share * centre[self.panel_of_vertex]
         return out
 
