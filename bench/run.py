@@ -17,7 +17,7 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 BENCHMARKS = ("startup", "scaling", "time_to_solution", "convergence", "accuracy",
-              "real_patterns", "paths", "load", "reading", "origami_simulator")
+              "real_patterns", "paths", "load", "reading", "origami_simulator", "flat_vertex")
 
 
 def main() -> int:

@@ -192,7 +192,7 @@ def test_report_gives_each_actuated_crease_and_where_the_hinge_model_breaks(tmp_
     2·atan(W/H) (157/103/136/103°), are listed as pivoting, the vertex binds and
     the strips' misfit and the panels' overlap are reported; angle-controlled
     actuation meets the actuated target where equal weights do not."""
-    pattern = patterns.degree4_vertex(rho1=180.0)
+    pattern = patterns.degree4_vertex(rho1=180.0, widths=(16.0, 4.0, 8.0, 4.0))
     src = tmp_path / "d4.fold"
     write_fold(src, pattern, thickness=3.175)
     misses = {}

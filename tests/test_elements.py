@@ -121,6 +121,11 @@ def _hinge_random(p, rng):
     reach = 0.95 * 2.0 * p[:, W] / p[:, H]
     p[arc, MAX_ANGLE] = np.minimum(p[arc, MAX_ANGLE], reach[arc])
     p[arc, TARGET] = np.clip(p[arc, TARGET], -reach[arc], reach[arc])
+    # an Eq. 8 trapezoid's inner face has negative width past 2·atan(W/H)
+    eq8 = p[:, MODEL] == EQ8
+    reach = 0.95 * 2.0 * np.arctan(p[:, W] / p[:, H])
+    p[eq8, MAX_ANGLE] = np.minimum(p[eq8, MAX_ANGLE], reach[eq8])
+    p[eq8, TARGET] = np.clip(p[eq8, TARGET], -reach[eq8], reach[eq8])
     return p
 
 
@@ -511,6 +516,27 @@ def test_axis_hinge_past_its_pivot_angle_keeps_a_zero_inner_radius(phi):
     assert _d(out, 0, 4) == pytest.approx(0.8, rel=1e-12)
 
 
+@pytest.mark.parametrize("phi", [1.0, -1.0])
+@pytest.mark.parametrize("length, kept", [(0.96, 0.96), (1.2, 1.0), (0.8, None)])
+def test_slack_strip_keeps_its_own_length_between_its_bounds(phi, length, kept):
+    """A slack strip (W = 1, H = 0.8, φ = ±1 rad) bent on an arc of length ℓ is
+    projected onto the arc of ℓ kept between the axis hinge's length
+    (0.5/tan 0.5 = 0.915) and W = 1: inside, the strip is its own target (residual
+    at rounding); outside, the target's neutral chord is the bound's,
+    2(ℓ/φ)·sin(φ/2), to rounding."""
+    from elements.bending_hinge import SLACK, arc_shape, axis_length, neutral_chord
+
+    rest = _strip()
+    bent = np.empty_like(rest)
+    arc_shape(rest, 1.0, phi, length, bent)
+    out, energy, _ = _project_strip(rest, phi, SLACK, x=bent)
+    kept = axis_length(1.0, 0.8, phi, phi) if kept is None else kept
+    chord = 2 * kept / abs(phi) * math.sin(abs(phi) / 2)
+    assert neutral_chord(out, np.arange(8)) == pytest.approx(chord, rel=1e-12)
+    if length == kept:
+        assert energy[0] < 1e-24
+
+
 def test_pivot_blend_is_one_constant_on_both_sides_of_the_layering():
     """elements cannot import foldcore, foldcore.hinges must not import numba: the
     rounding band of the axis hinge's switch is written twice and kept equal here."""
@@ -522,7 +548,7 @@ def test_pivot_blend_is_one_constant_on_both_sides_of_the_layering():
 
 def test_bend_is_continuous_at_zero():
     rest = _strip()
-    for model in (EQ8, ARC, AXIS):
+    for model in (EQ8, ARC, AXIS, 3.0):  # 3: slack
         out, energy, _ = _project_strip(rest, 1e-13, model, strips=4)
         assert np.allclose(out, rest, rtol=0, atol=1e-12) and energy[0] < 1e-24
 

@@ -7,6 +7,16 @@ three: its arc radius must be the sum of theirs. Arc hinges (radius W / π at
 reach flat; widths that satisfy the sum at every vertex
 (:func:`foldcore.patterns.miura_flat_widths` for a Miura) fold it exactly.
 
+Pehrson's thick vertex (H = 3.175 mm, widths 16/4/8/4 mm from its wrapping
+crease on) folds flat with slack hinges, whose strips may lengthen up to their
+width: the wrapping crease then spans the three layers (3H = 9.5 mm, an arc of
+16 mm spans up to 10.2 mm). Its flat state is compatible, so it is reached to
+the run's tolerance (1e-8 × 152 mm over hinges ≥ 4 mm: ≤ 1e-4°; 0.01° asserted)
+with its panels in four layers whose mid-planes are at least H apart, to the
+positions' rounding at that tolerance (1e-4 mm); two panels' solids may share
+a face there but overlap by no more than 1e-4 of a panel. Axis hinges hold
+every flat crease's panels H apart, so the same vertex binds short of flat.
+
 Bounds: a compatible flat state is reached to the run's tolerance, 1e-8 ×
 size; over a hinge of width W ≥ 0.785 mm that is a fold angle within
 2 × 1e-8 × 100 mm / W ≈ 1.5e-4°, so 1e-3° per crease. The incompatible ones
@@ -16,10 +26,15 @@ docs/architecture.md#a-thick-miura-has-no-flat-state-with-equal-hinges).
 """
 from __future__ import annotations
 
+import json
+import subprocess
+import sys
+
 import numpy as np
 import pytest
 
 from foldcore import patterns
+from foldcore.io import write_fold
 from foldcore.simulation import Simulation
 from foldcore.thickening import thicken
 
@@ -45,9 +60,7 @@ def flat_vertex(widths):
 
 def test_wrapping_crease_as_wide_as_the_other_three_folds_a_vertex_flat():
     width = np.pi / 2 * H  # Eq. 7: the arc's inner radius is 0 at 180°
-    mv = patterns.degree4_assignments(SECTORS, "B")
-    odd = [k for k in range(4) if mv.count(mv[k]) == 1][0]
-    wrap = (odd + 2) % 4
+    wrap = patterns.wrapping_crease(patterns.degree4_assignments(SECTORS, "B"))
     widths = [3 * width if k == wrap else width for k in range(4)]
     pattern, targets = flat_vertex(widths)
     miss = np.abs(fold_flat(pattern, H)[:4] - targets)
@@ -116,3 +129,65 @@ def test_rigid_model_folds_a_graded_miura_flat():
 def test_miura_flat_widths_refuses_a_bad_width():
     with pytest.raises(Exception, match="width"):
         patterns.miura_flat_widths(3, 3, 0.0)
+
+
+PEHRSON_H = 3.175  # mm
+
+
+def pehrson_flat_file(tmp_path, hinge: str):
+    """FOLD of Pehrson's vertex (mode A), every crease's target ±180°, ``hinge`` joints."""
+    pattern = patterns.degree4_vertex(mode="A")
+    targets = [180.0 if a == "V" else -180.0 for a in pattern.assignments[:4]]
+    pattern = pattern.replace(fold_angles=targets + [None] * (pattern.n_edges - 4))
+    path = tmp_path / f"pehrson-{hinge}.fold"
+    write_fold(path, pattern, thickness=PEHRSON_H, extra={
+        "foldcore:edges_hinge": [hinge] * 4 + [None] * (pattern.n_edges - 4)})
+    return path, np.array(targets)
+
+
+def simulate(path, *options):
+    out = path.with_suffix(".out.fold")
+    done = subprocess.run([sys.executable, "-m", "foldcore", "simulate", str(path), "-o",
+                           str(out), *options], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    return json.loads(out.read_text())
+
+
+def layers(frame):
+    """Mid-plane heights (mm) of the panels of a folded vertex, sorted, along the
+    normal of panel 0 (its top and bottom faces' mean offset)."""
+    from solids import panel_points
+
+    points = panel_points(frame)
+    first = points[0] - points[0].mean(axis=0)
+    normal = np.linalg.svd(first)[2][2]
+    return np.sort([p.mean(axis=0) @ normal for p in points.values()])
+
+
+def test_pehrsons_vertex_folds_flat_in_four_layers_with_slack_hinges(tmp_path):
+    from solids import folded_frame, hull, panel_overlaps, panel_points
+
+    path, targets = pehrson_flat_file(tmp_path, "slack")
+    fold = simulate(path)
+    angles = np.array(fold["edges_foldAngle"][:4])  # the achieved angles
+    assert np.abs(angles - targets).max() < 0.01
+    frame = folded_frame(fold)
+    gaps = np.diff(layers(frame))
+    assert len(gaps) == 3 and gaps.min() >= PEHRSON_H - 1e-4  # four layers, none shared
+    smallest = min(hull(p).volume() for p in panel_points(frame).values())
+    assert all(v <= 1e-4 * smallest for _, _, v in panel_overlaps(frame))
+
+
+def test_pehrsons_vertex_binds_short_of_flat_with_axis_hinges(tmp_path):
+    path, targets = pehrson_flat_file(tmp_path, "axis")
+    fold = simulate(path)
+    angles = np.array(fold["edges_foldAngle"][:4])
+    assert np.abs(angles - targets).max() > SHORT
+
+
+def test_the_rigid_strategy_refuses_slack_hinges(tmp_path):
+    path, _ = pehrson_flat_file(tmp_path, "slack")
+    done = subprocess.run([sys.executable, "-m", "foldcore", "simulate", str(path),
+                           "--solver", "rigid"], capture_output=True, text=True)
+    assert done.returncode == 2 and "Traceback" not in done.stderr
+    assert "slack" in done.stderr and "0, 1, 2, 3" in done.stderr

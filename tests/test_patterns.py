@@ -19,7 +19,8 @@ def test_pehrson_default():
     assert (cp.n_vertices, cp.n_edges, len(cp.faces)) == (7, 10, 4)
     assert list(cp.assignments[:4]) == ["V", "V", "V", "M"]
     assert np.all(cp.assignments[4:] == "B")
-    assert np.allclose(cp.widths[:4], [16, 4, 8, 4]) and np.isnan(cp.widths[4:]).all()
+    # the 16 mm hinge on the wrapping crease (opposite the odd M), 8 mm opposite it
+    assert np.allclose(cp.widths[:4], [4, 16, 4, 8]) and np.isnan(cp.widths[4:]).all()
     ends = cp.vertices[cp.edges[:4, 1]] - cp.vertices[cp.edges[:4, 0]]
     assert np.allclose(np.hypot(*ends.T), 76.2)
     assert np.allclose(np.degrees(np.arctan2(ends[:, 1], ends[:, 0])) % 360, [0, 135, 225, 270])
@@ -39,6 +40,17 @@ def test_degree4_assignment_matches_closed_form(mode, sectors):
     odd = [i for i in range(4) if sum(cp.assignments[:4] == cp.assignments[i]) == 1]
     assert len(odd) == 1 and odd[0] in ((1, 3) if mode == "A" else (0, 2))
     assert cp.assignments[0] == "V"
+
+
+def test_wrapping_crease_is_opposite_the_odd_assignment():
+    assert p.wrapping_crease(p.degree4_vertex(mode="A").assignments[:4]) == 1
+    assert p.wrapping_crease(p.degree4_vertex(mode="B").assignments[:4]) == 0
+    assert p.wrapping_crease(["M", "M", "M", "V"]) == 1
+    assert np.allclose(p.degree4_vertex(mode="B").widths[:4], [16, 4, 8, 4])
+    with pytest.raises(PatternError, match="exactly one"):
+        p.wrapping_crease(["V", "V", "M", "M"])
+    with pytest.raises(PatternError, match="'pehrson'"):
+        p.degree4_vertex(widths="wide")
 
 
 def test_pehrson_mode_b_and_mirror():

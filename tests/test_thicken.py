@@ -474,7 +474,7 @@ def test_eq1_obtuse_sector_corner_behind_vertex_is_clamped():
     theta = math.radians(135)
     a = (4 + 16 * math.cos(theta)) / (2 * math.sin(theta))
     assert a < 0
-    pattern = patterns.degree4_vertex()
+    pattern = patterns.degree4_vertex(widths=(16.0, 4.0, 8.0, 4.0))
     mesh = thicken(pattern, 1.0, subdivisions=2)
     check_mesh(pattern, mesh, 1.0)
     x = panel_corner_near(mesh, 0, np.zeros(2))
@@ -573,7 +573,7 @@ def test_hinge_width_per_edge_array():
 
 
 def test_pattern_widths_used_by_default():
-    pattern = patterns.degree4_vertex()
+    pattern = patterns.degree4_vertex(widths=(16.0, 4.0, 8.0, 4.0))
     mesh = thicken(pattern, 1.0, subdivisions=2)
     np.testing.assert_allclose(mesh.hinge_width[:4], [16, 4, 8, 4])
 

@@ -38,6 +38,8 @@ fixed points of their own estimate. The angle used is written to
 """
 import math
 
+import numpy as np
+
 from numba import njit, prange
 
 from ._registry import ElementType
@@ -47,7 +49,7 @@ from ._strip import distance, strip_widths
 HINGE_PARAMS = ("width", "height", "target", "sign", "max_angle", "floor", "model", "strips",
                 "series")
 W, H, TARGET, SIGN, MAX_ANGLE, FLOOR, MODEL, STRIPS, SERIES = range(len(HINGE_PARAMS))
-EQ8, ARC, AXIS = 0.0, 1.0, 2.0  # ``model`` codes (foldcore.hinges.HINGE_MODELS order)
+EQ8, ARC, AXIS, SLACK = 0.0, 1.0, 2.0, 3.0  # ``model`` codes (foldcore.hinges.HINGE_MODELS order)
 PIVOT_BLEND = 0.05  # width (× w) of the band in which the axis hinge turns into pivoting
 
 
@@ -155,41 +157,94 @@ def bent_shape(rest, width, height, phi, model, theta, out):
     (a strip has two: its vertices share x across the thickness and along the
     crease) and kept in ``out``'s rows meanwhile.
     """
-    m = rest.shape[0]
-    turn = phi / width  # ψ per mm of rest x
     if model != EQ8 and abs(phi) >= 1e-12:
         length = width if model == ARC else axis_length(width, height, phi, theta)
-        kappa = phi / length
-        for k in range(m):  # pass 1: (sin ψ, cos ψ, 2 sin²(ψ/2)) per vertex
-            shared = -1
-            for j in range(k):
-                if rest[j, 0] == rest[k, 0]:
-                    shared = j
-                    break
-            if shared >= 0:
-                out[k, 0], out[k, 1], out[k, 2] = out[shared, 0], out[shared, 1], out[shared, 2]
-            else:
-                half = 0.5 * turn * rest[k, 0]
-                sh, ch = math.sin(half), math.cos(half)
-                out[k, 0], out[k, 1], out[k, 2] = 2.0 * sh * ch, 1.0 - 2.0 * sh * sh, 2.0 * sh * sh
-        for k in range(m):  # pass 2: the bent point
-            y = rest[k, 1]
-            sin_psi, cos_psi, versine = out[k, 0], out[k, 1], out[k, 2]
-            out[k, 0] = (1.0 - kappa * y) * sin_psi / kappa
-            out[k, 1] = versine / kappa + y * cos_psi
-            out[k, 2] = rest[k, 2]
+        arc_shape(rest, width, phi, length, out)
     else:
-        for k in range(m):
+        for k in range(rest.shape[0]):
             x, y = rest[k, 0], rest[k, 1]
             out[k, 0] = x * (1.0 - 2.0 * y / width * math.tan(0.5 * phi)) if model == EQ8 else x
             out[k, 1] = y
             out[k, 2] = rest[k, 2]
+        centre(out)
+
+
+@njit(cache=True)
+def arc_shape(rest, width, phi, length, out):
+    """Write the strip bent by ``phi`` (rad, ≠ 0) along a neutral axis of ``length``
+    (mm) into ``out`` (m, 3), centred, local frame (see :func:`bent_shape`)."""
+    m = rest.shape[0]
+    turn = phi / width  # ψ per mm of rest x
+    kappa = phi / length
+    for k in range(m):  # pass 1: (sin ψ, cos ψ, 2 sin²(ψ/2)) per vertex
+        shared = -1
+        for j in range(k):
+            if rest[j, 0] == rest[k, 0]:
+                shared = j
+                break
+        if shared >= 0:
+            out[k, 0], out[k, 1], out[k, 2] = out[shared, 0], out[shared, 1], out[shared, 2]
+        else:
+            half = 0.5 * turn * rest[k, 0]
+            sh, ch = math.sin(half), math.cos(half)
+            out[k, 0], out[k, 1], out[k, 2] = 2.0 * sh * ch, 1.0 - 2.0 * sh * sh, 2.0 * sh * sh
+    for k in range(m):  # pass 2: the bent point
+        y = rest[k, 1]
+        sin_psi, cos_psi, versine = out[k, 0], out[k, 1], out[k, 2]
+        out[k, 0] = (1.0 - kappa * y) * sin_psi / kappa
+        out[k, 1] = versine / kappa + y * cos_psi
+        out[k, 2] = rest[k, 2]
+    centre(out)
+
+
+@njit(cache=True)
+def centre(out):
+    """Shift ``out`` (m, 3) so its x and y means are 0 (the local frame's origin)."""
+    m = out.shape[0]
     for d in range(2):
         mean = 0.0
         for k in range(m):
             mean += out[k, d]
         for k in range(m):
             out[k, d] -= mean / m
+
+
+@njit(cache=True)
+def neutral_chord(x, ids):
+    """Distance (mm) between the centres of a strip's two end faces (vertices 0, 3,
+    4, 7 on the left, 1, 2, 5, 6 on the right): the chord of its neutral axis."""
+    total = 0.0
+    for d in range(3):
+        left = x[ids[0], d] + x[ids[3], d] + x[ids[4], d] + x[ids[7], d]
+        right = x[ids[1], d] + x[ids[2], d] + x[ids[5], d] + x[ids[6], d]
+        total += (0.25 * (right - left)) ** 2
+    return math.sqrt(total)
+
+
+@njit(cache=True)
+def slack_length(x, ids, width, height, phi, theta):
+    """Neutral-axis length (mm) a ``SLACK`` sub-strip is projected with: the length
+    of the arc bent by φ on its current neutral chord c, ℓ = c·(φ/2)/sin(φ/2),
+    kept between the axis hinge's (:func:`axis_length`: the shortest, panels
+    turning about the crease's mid-line) and max(w, H·|φ|/2) (no longer than
+    its rest width, unless its inner surface would need a radius below 0)."""
+    low = axis_length(width, height, phi, theta)
+    high = max(width, 0.5 * height * abs(phi), low)
+    half = 0.5 * phi
+    chord = neutral_chord(x, ids)
+    length = chord if abs(half) < 1e-6 else chord * half / math.sin(half)
+    return min(max(length, low), high)
+
+
+@njit(cache=True)
+def bend_from(x, ids, rest, params, phi, theta, out):
+    """:func:`bend`, a ``SLACK`` strip with the length :func:`slack_length` reads
+    from its current shape ``x[ids]``."""
+    if params[MODEL] == SLACK and abs(phi) >= 1e-12:
+        arc_shape(rest, params[W], phi,
+                  slack_length(x, ids, params[W], params[H], phi, theta), out)
+    else:
+        bend(rest, params, phi, theta, out)
 
 
 @njit(cache=True)
@@ -242,7 +297,7 @@ def project(x, ids, rest, params, out, state):
     """
     phi = strip_angle(x, ids, params)
     state[0] = phi
-    bend(rest, params, phi, params[STRIPS] * phi, out)
+    bend_from(x, ids, rest, params, phi, params[STRIPS] * phi, out)
     return fit_rotated(x, ids, out, out)
 
 
@@ -250,7 +305,7 @@ def project(x, ids, rest, params, out, state):
 def project_in_series(x, ids, rest, params, angles, e, out):
     """Rotated target of strip ``e`` bent by ``angles[e, 0]`` for its crease's bend
     (:func:`series_bend` over ``angles``), written to ``out``; its residual (mm²)."""
-    bend(rest, params[e], angles[e, 0], series_bend(angles, params, e), out)
+    bend_from(x, ids, rest, params[e], angles[e, 0], series_bend(angles, params, e), out)
     return fit_rotated(x, ids, out, out)
 
 
@@ -295,11 +350,74 @@ def prepared_batch(x, indptr, indices, rest, shapes, params, out, energy, state)
         state[e, 0] = strip_angle(x, indices[indptr[e]:indptr[e + 1]], params[e])
     for e in prange(len(indptr) - 1):
         s, t = indptr[e], indptr[e + 1]
-        if math.isnan(params[e, TARGET]):
+        if math.isnan(params[e, TARGET]) or params[e, MODEL] == SLACK:
             energy[e] = project_in_series(x, indices[s:t], rest[s:t], params, state, e,
                                           out[s:t])
         else:
             energy[e] = fit_rotated(x, indices[s:t], shapes[s:t], out[s:t])
+
+
+@njit(parallel=True, cache=True)
+def slack_lengths(x, indptr, indices, params, phi, out):
+    """Neutral-axis length (mm) of every ``SLACK`` sub-strip bent by ``phi`` (S,) rad,
+    its crease's strips alike (:func:`slack_length`), into ``out`` (S,); NaN for
+    strips of other models."""
+    for e in prange(len(indptr) - 1):
+        p = params[e]
+        if p[MODEL] != SLACK:
+            out[e] = math.nan
+            continue
+        out[e] = slack_length(x, indices[indptr[e]:indptr[e + 1]], p[W], p[H], phi[e],
+                              p[STRIPS] * phi[e])
+
+
+SLACK_STEP = 1e-6  # × w, central-difference step of :func:`slack_directions`
+
+
+@njit(parallel=True, cache=True)
+def slack_directions(x, indptr, indices, rest, params, state, out):
+    """How each free ``SLACK`` sub-strip's projection moves per mm of its length.
+
+    For solvers that linearise the projections (``newton``): a slack strip's
+    target follows its own length between the bounds of :func:`slack_length`,
+    a freedom its rotations alone do not span. Central difference (step
+    ``SLACK_STEP`` × w) of the rotated target at the state's angles.
+
+    Parameters
+    ----------
+    x : (N, 3) positions, mm
+    indptr, indices : the group's slots
+    rest : (nnz, 3) centred rest shapes, mm
+    params : (S, 9) see ``HINGE_PARAMS``
+    state : (S, 1) angles of the last projection, rad
+    out : (nnz, 3) written: d(R·T)/dℓ (dimensionless), zero for strips of
+        other models and slack strips held at a bound
+    """
+    for e in prange(len(indptr) - 1):
+        s, t = indptr[e], indptr[e + 1]
+        for k in range(s, t):
+            out[k, 0], out[k, 1], out[k, 2] = 0.0, 0.0, 0.0
+        p = params[e]
+        phi = state[e, 0]
+        if p[MODEL] != SLACK or abs(phi) < 1e-12:
+            continue
+        ids = indices[s:t]
+        theta = series_bend(state, params, e)
+        length = slack_length(x, ids, p[W], p[H], phi, theta)
+        low = axis_length(p[W], p[H], phi, theta)
+        high = max(p[W], 0.5 * p[H] * abs(phi), low)
+        step = SLACK_STEP * p[W]
+        if length - step <= low or length + step >= high:
+            continue
+        up = np.empty((t - s, 3))
+        down = np.empty((t - s, 3))
+        arc_shape(rest[s:t], p[W], phi, length + step, up)
+        arc_shape(rest[s:t], p[W], phi, length - step, down)
+        fit_rotated(x, ids, up, up)
+        fit_rotated(x, ids, down, down)
+        for k in range(t - s):
+            for d in range(3):
+                out[s + k, d] = (up[k, d] - down[k, d]) / (2.0 * step)
 
 
 SHAPE_STEP = 1e-6  # rad, central-difference step of :func:`shape_derivatives`

@@ -184,7 +184,9 @@ def _add_thickening(sim) -> None:
     sim.add_argument("--hinge", choices=HINGE_MODELS,
                      help="hinge model of every crease: axis (panels turn about the crease, "
                           "rigid-origami kinematics at any thickness), arc (the paper's "
-                          "constant-length arc) or eq8 (the paper's Eq. 8 trapezoid); default: "
+                          "constant-length arc), eq8 (the paper's Eq. 8 trapezoid) or slack "
+                          "(compliant joints: an arc of free length between axis's and the "
+                          "width; solvers hybrid and newton); default: "
                           f"the file's foldcore:edges_hinge, else {DEFAULT_HINGE}")
     sim.add_argument("--eq8", dest="hinge", action="store_const", const="eq8",
                      help="same as --hinge eq8")
@@ -420,11 +422,9 @@ def render_result(args) -> int:
     res = read_result(args.result, args.hinge_width, args.subdivisions)
     options = {}
     if args.color_by == "strain":   # largest surface tension of each sub-strip
-        from .strain import estimated_strip_angles, strip_strains
+        from .strain import strains_at
 
-        hinges = res.mesh.groups["bending_hinge"]
-        values = strip_strains(hinges.params,
-                               estimated_strip_angles(hinges, res.positions)).max(axis=1)
+        values = strains_at(res.mesh.groups["bending_hinge"], res.positions).max(axis=1)
         options = dict(scalars=values, clim=colour_limits(values, signed=False),
                        cmap="viridis", scalar_name="surface tension strain")
     elif args.color_by != "none":   # signed angles, valley > 0: blue, mountain < 0: red

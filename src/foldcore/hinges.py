@@ -3,7 +3,7 @@
 A crease of width W in a sheet of thickness H becomes k sub-strips, each a
 prism bent by φ (θ = kφ for the crease). Where the panels go is decided by
 the bent shape of the strip's end faces — a modelling choice, and one that
-decides whether thick vertices can fold at all. Three models
+decides whether thick vertices can fold at all. Four models
 (``thicken(..., hinge=...)``, ``--hinge``, FOLD ``foldcore:edges_hinge``);
 measured figures for each: docs/architecture.md#hinge-models-in-numbers.
 
@@ -40,6 +40,21 @@ measured figures for each: docs/architecture.md#hinge-models-in-numbers.
     crease (≈ W·θ²/12 at small θ, 0.12 W at 70°), so the hinges around a
     vertex do not meet and every closed loop must strain to fold.
 
+``"slack"`` — a compliant joint whose length is free within bounds: each
+    sub-strip bends on an arc of the length it has (the chord between its
+    end faces' centres, ℓ = c·(φ/2)/sin(φ/2)), kept between the axis hinge's
+    (the shortest: panels turning about the crease's mid-line) and max(W,
+    H·|θ|/2) (no longer than its width unless its inner surface would need a
+    negative radius). Where the axis path is compatible it is one of its
+    states, so the hinge folds like the axis hinge; where that path binds, a
+    strip lengthens up to W — flat, a crease of width W can hold its panels
+    from H to 2W/π apart — which lets a thick vertex fold flat with its
+    wrapping crease three layers wide (``scenes.d4v``). The freedom makes
+    some states a family (the stack of a flat vertex may open up to what its
+    widths allow); ``rigid`` refuses these hinges (its strips have the length
+    their angle sets), ``hybrid`` takes its rigid steps as a predictor and
+    finishes with ``newton``, whose steps move along the strips' lengths too.
+
 ``"eq8"`` — the paper's Eq. 8 trapezoid: the arc's linear approximation
     (end faces sheared, error O(φ²)), with the arc's drift.
 
@@ -48,8 +63,8 @@ Units: mm, degrees at this API.
 from __future__ import annotations
 
 #: Hinge model names, in the order of the kernels' ``model`` codes (see
-#: :mod:`elements.bending_hinge`): ``eq8`` 0, ``arc`` 1, ``axis`` 2.
-HINGE_MODELS = ("eq8", "arc", "axis")
+#: :mod:`elements.bending_hinge`): ``eq8`` 0, ``arc`` 1, ``axis`` 2, ``slack`` 3.
+HINGE_MODELS = ("eq8", "arc", "axis", "slack")
 DEFAULT_HINGE = "axis"
 PIVOT_BLEND = 0.05  # = elements.bending_hinge.PIVOT_BLEND (× W; a test keeps them equal)
 
@@ -58,14 +73,16 @@ def neutral_length(model: str, width, thickness: float, theta):
     """Neutral-axis length (mm) of a crease's strip of width W bent by θ (rad) in total.
 
     ``axis``: max(W·f(θ), H·|θ|/2), f(θ) = (θ/2)/tan(θ/2), rounded within
-    ``PIVOT_BLEND`` × W of the switch; ``arc`` and ``eq8``: W. Each of k equal
+    ``PIVOT_BLEND`` × W of the switch; ``slack``: the same, its shortest (its
+    length at a state is measured: :func:`foldcore.strain.strains_at`);
+    ``arc`` and ``eq8``: W. Each of k equal
     sub-strips has 1/k of it (the kernels'
     :func:`elements.bending_hinge.axis_length` with w = W/k, φ = θ/k).
     """
     import numpy as np  # here: the names above are read by the command line, kept light
 
     width, theta = np.asarray(width, dtype=float), np.asarray(theta, dtype=float)
-    if model != "axis":
+    if model not in ("axis", "slack"):
         return np.broadcast_to(width, np.broadcast(width, theta).shape).copy()
     half = 0.5 * theta
     small = np.abs(half) < 1e-4

@@ -61,7 +61,7 @@ class Thickening:
         Hinge width W of every crease, mm (default: the file's, else Eq. 7).
     subdivisions : int or "auto"
         Sub-strips per hinge.
-    hinge : {"axis", "arc", "eq8"}, optional
+    hinge : {"axis", "arc", "eq8", "slack"}, optional
         Hinge model of every crease (default: the file's, else axis).
     elastic_cells : float, optional
         Elastic panels: every face cut into rings of cells about this long, mm

@@ -18,7 +18,7 @@ from .pattern import CreasePattern
 
 __all__ = ["degree4_vertex", "single_vertex", "waterbomb", "miura", "miura_edge_kinds",
            "miura_fold_angles", "miura_flat_widths", "miura_one_crease", "single_hinge", "grid",
-           "degree4_assignments"]
+           "degree4_assignments", "wrapping_crease"]
 
 PEHRSON_SECTORS = (135.0, 90.0, 45.0, 90.0)
 PEHRSON_WIDTHS = (16.0, 4.0, 8.0, 4.0)
@@ -27,7 +27,7 @@ _TOL = 1e-9
 
 
 # ------------------------------------------------------------ degree-4 vertex
-def degree4_vertex(sectors=PEHRSON_SECTORS, radius: float = 76.2, widths=PEHRSON_WIDTHS,
+def degree4_vertex(sectors=PEHRSON_SECTORS, radius: float = 76.2, widths="pehrson",
                    mode: str = "A", rho1=None, assignments=None,
                    flat_foldable: bool = True) -> CreasePattern:
     """A single degree-4 vertex on a polygonal disc (default: Pehrson's vertex).
@@ -42,8 +42,14 @@ def degree4_vertex(sectors=PEHRSON_SECTORS, radius: float = 76.2, widths=PEHRSON
         summing to 360. Crease 1 is at 0°, crease i at α_1 + … + α_{i−1}.
     radius : float, mm
         Distance from the vertex to each crease end (disc radius).
-    widths : 4 floats or None, mm
-        Hinge width per crease (NaN / None = auto).
+    widths : 4 floats or None, mm, or "pehrson"
+        Hinge width per crease (NaN / None = auto). ``"pehrson"``: 16, 4, 8,
+        4 mm from the wrapping crease on (:func:`wrapping_crease`; from crease
+        1 where no crease's M/V differs from the other three's): folded
+        flat, its two panels hold the other two between them, so it spans
+        three layers where the others span one; 16 = 4 + 8 + 4 keeps the
+        four layers apart with hinges that keep their width (an arc of
+        width W holds its panels 2W/π apart).
     mode : {"A", "B"}
         Folding branch that sets M/V (:func:`foldcore.kinematics.degree4_mode_a`,
         :func:`~foldcore.kinematics.degree4_mode_b`): the crease whose
@@ -74,8 +80,26 @@ def degree4_vertex(sectors=PEHRSON_SECTORS, radius: float = 76.2, widths=PEHRSON
             raise PatternError("degree4_vertex: mode A/B is defined for flat-foldable "
                                "vertices only; pass assignments for a general vertex")
         assignments = degree4_assignments(sectors, mode, -1.0 if _neg(rho1) else 1.0)
+    if isinstance(widths, str):
+        if widths != "pehrson":
+            raise PatternError(f"degree4_vertex: widths must be 4 numbers, None or "
+                               f"'pehrson', got {widths!r}")
+        odd = [a for a in assignments if list(assignments).count(a) == 1]
+        widths = np.roll(PEHRSON_WIDTHS, wrapping_crease(assignments) if len(odd) == 1 else 0)
     return _vertex_pattern(sectors, radius, widths, assignments, [rho1, None, None, None],
                            "degree4_vertex")
+
+
+def wrapping_crease(assignments) -> int:
+    """Index (0-based) of the crease of a flat-folded degree-4 vertex whose panels
+    hold the other two between them: the one opposite the crease whose M/V
+    differs from the other three's. PatternError if no crease differs so."""
+    signs = [a.upper() for a in assignments]
+    odd = [i for i in range(4) if sum(s == signs[i] for s in signs) == 1]
+    if len(signs) != 4 or len(odd) != 1:
+        raise PatternError(f"wrapping crease: need 4 assignments with exactly one "
+                           f"differing from the others, got {list(assignments)}")
+    return (odd[0] + 2) % 4
 
 
 def single_vertex(sectors, assignments, fold_angles=None, radius: float = 50.0,

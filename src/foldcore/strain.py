@@ -27,33 +27,54 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from elements.bending_hinge import AXIS, EQ8, H, MODEL, STRIPS, W, estimate_angles
+from elements.bending_hinge import (AXIS, EQ8, H, MODEL, SLACK, STRIPS, W, estimate_angles,
+                                     slack_lengths)
 from .hinges import neutral_length
 
 TOP, BOTTOM = 0, 1
 
 
-def strip_strains(params: np.ndarray, phi: np.ndarray) -> np.ndarray:
+def strip_strains(params: np.ndarray, phi: np.ndarray, slack=None) -> np.ndarray:
     """(S, 2) surface strains (top, bottom) of sub-strips bent by ``phi`` (S,) rad.
 
     ``params`` (S, 9) are the hinge parameters (``HINGE_PARAMS``): width w,
     height H, the hinge model and its sub-strip count decide the formula
-    (module docstring).
+    (module docstring). ``slack`` (S,) mm: the neutral-axis lengths of slack
+    strips (:func:`strains_at` measures them; default: their shortest).
     """
     ratio = params[:, H] / params[:, W]
     model = params[:, MODEL]
     bend = np.where(model == EQ8, ratio * np.tan(0.5 * phi), 0.5 * phi * ratio)
-    axial = neutral_lengths(params, phi) / params[:, W] - 1.0
+    axial = neutral_lengths(params, phi, slack) / params[:, W] - 1.0
     return np.column_stack([axial - bend, axial + bend])
 
 
-def neutral_lengths(params: np.ndarray, phi: np.ndarray) -> np.ndarray:
+def strains_at(hinge_group, positions: np.ndarray, phi=None) -> np.ndarray:
+    """(S, 2) :func:`strip_strains` of ``hinge_group``'s sub-strips at ``positions``
+    (N, 3) mm, bent by ``phi`` (S,) rad (default: their Eq. 9 estimates), slack
+    strips' lengths measured."""
+    params = hinge_group.params
+    if phi is None:
+        phi = estimated_strip_angles(hinge_group, positions)
+    slack = None
+    if np.any(params[:, MODEL] == SLACK):
+        slack = np.empty(len(phi))
+        slack_lengths(positions, hinge_group.indptr, hinge_group.indices, params, phi, slack)
+    return strip_strains(params, phi, slack)
+
+
+def neutral_lengths(params: np.ndarray, phi: np.ndarray, slack=None) -> np.ndarray:
     """(S,) neutral-axis length (mm) of sub-strips bent by ``phi`` (S,) rad, each
     crease's strips alike: 1/k of their crease's for axis hinges
-    (:func:`foldcore.hinges.neutral_length`), the width w for the others."""
+    (:func:`foldcore.hinges.neutral_length`), ``slack`` (S,) for slack ones
+    (default: the axis hinge's, their shortest), the width w for the others."""
     k = params[:, STRIPS]
+    model = params[:, MODEL]
     axis = neutral_length("axis", k * params[:, W], params[:, H], k * phi) / k
-    return np.where(params[:, MODEL] == AXIS, axis, params[:, W])
+    lengths = np.where((model == AXIS) | (model == SLACK), axis, params[:, W])
+    if slack is not None:
+        lengths = np.where(model == SLACK, slack, lengths)
+    return lengths
 
 
 def estimated_strip_angles(hinge_group, positions: np.ndarray) -> np.ndarray:
@@ -114,7 +135,7 @@ class FailureMonitor:
     def check(self, positions: np.ndarray, iteration: int, fold_percent: float) -> None:
         """Record creases whose sub-strips exceed a limit now (first time only)."""
         phi = estimated_strip_angles(self.group, positions)
-        strain = strip_strains(self.group.params, phi)
+        strain = strains_at(self.group, positions, phi)
         over_t = strain.max(axis=1) > self.tension
         over_c = -strain.min(axis=1) > self.compression
         for s in np.flatnonzero(over_t | over_c):

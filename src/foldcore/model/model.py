@@ -321,10 +321,9 @@ class Model:
         """(S, 2) top/bottom surface strain of each sub-strip at the current shape."""
         if self.hinges is None:
             return np.zeros((0, 2))
-        from ..strain import estimated_strip_angles, strip_strains
+        from ..strain import strains_at
 
-        g = self.hinges.group
-        return strip_strains(g.params, estimated_strip_angles(g, self.x))
+        return strains_at(self.hinges.group, self.x)
 
     def hinge_misfits(self) -> np.ndarray:
         """(S,) RMS distance (mm) of each hinge sub-strip's vertices from its rotated

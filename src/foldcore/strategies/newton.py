@@ -16,7 +16,11 @@ P_e, ½∇²E ≈ H = K ⊗ I₃ − Σ_e w_e Q_e Q_eᵀ (each element's term w_
 a projector: H is positive semi-definite, singular along rigid motions of the
 whole sheet). A passive strip can also bend toward x (its Eq. 9 angle); that
 freedom is left out of H, which then overestimates the strip's stiffness: the
-step is shorter, never wrong, since each step must lower E.
+step is shorter, never wrong, since each step must lower E. A slack strip's
+length follows x too (:mod:`foldcore.hinges`); that freedom is in H (one
+more column of Q_e, the target's change per mm of length): left out, the
+strips resist the lengthening a binding vertex needs as stiffly as bending,
+and the steps crawl.
 
 A step solves (H + λ D) δ = −(K x − b), D the diagonal of K ⊗ I₃
 (Levenberg–Marquardt, damping λ relative), then takes ``corrections`` steps
@@ -44,6 +48,9 @@ from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
+
+from elements import bending_hinge
+from elements.bending_hinge import MODEL, SLACK
 
 from ..errors import SimulationError
 from ..linsolve import Factor
@@ -231,6 +238,7 @@ class Newton(Strategy):
             group = state.group
             sizes = np.diff(group.indptr)
             targets = all_targets[state.slots]
+            slack = slack_directions(model.x, state) if state is model.hinges else None
             for m in np.unique(sizes):
                 sel = np.flatnonzero(sizes == m)
                 slots = group.indptr[sel][:, None] + np.arange(m)
@@ -241,7 +249,33 @@ class Newton(Strategy):
                                   np.stack([p[..., 2], zero, -p[..., 0]], axis=2),
                                   np.stack([-p[..., 1], p[..., 0], zero], axis=2)], axis=3)
                 basis, _ = np.linalg.qr(turns.reshape(len(sel), 3 * int(m), 3))
+                if slack is not None:
+                    basis = _with_direction(basis, slack[slots].reshape(len(sel), -1))
                 yield group.indices[slots], weights[sel], basis
+
+
+def slack_directions(x: np.ndarray, hinges):
+    """(nnz, 3) how the projections of the hinge group ``hinges`` move per mm of
+    their slack strips' lengths (:func:`elements.bending_hinge.slack_directions`),
+    or None where no strip is a slack one."""
+    params = hinges.params
+    if not np.any(params[:, MODEL] == SLACK):
+        return None
+    group = hinges.group
+    out = np.zeros((len(group.indices), 3))
+    bending_hinge.slack_directions(x, group.indptr, group.indices, group.rest, params,
+                                   hinges.state, out)
+    return out
+
+
+def _with_direction(basis: np.ndarray, direction: np.ndarray) -> np.ndarray:
+    """``basis`` (n, d, c) orthonormal, with ``direction`` (n, d) orthonormalised
+    against it as one more column (a zero column where it is zero or in the span)."""
+    direction = direction - np.einsum("nij,nj->ni", basis, np.einsum("nij,ni->nj", basis,
+                                                                          direction))
+    norm = np.linalg.norm(direction, axis=1, keepdims=True)
+    scale = np.where(norm > 1e-9, 1.0 / np.maximum(norm, 1e-300), 0.0)
+    return np.concatenate([basis, (direction * scale)[:, :, None]], axis=2)
 
 
 class HessianPattern:

@@ -38,7 +38,7 @@ def thicken(pattern: CreasePattern, thickness: float, hinge_width=None,
         Sub-strips per hinge; "auto" uses :func:`auto_subdivisions`.
     bend_radius : float
         Inner bend radius r for Eq. 7 widths, mm.
-    hinge : {"axis", "arc", "eq8"} or (E,) of them (None entries: default), optional
+    hinge : {"axis", "arc", "eq8", "slack"} or (E,) of them (None entries: default), optional
         Hinge kinematics per crease (default
         :data:`foldcore.hinges.DEFAULT_HINGE`; :mod:`foldcore.hinges`); FOLD
         files carry it as ``foldcore:edges_hinge``.

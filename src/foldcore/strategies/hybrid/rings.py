@@ -89,7 +89,7 @@ class RigidStart:
         self.model, self.progress, self.mesh = model, progress, mesh
         self.twin = twin_model(model, mesh)
         self.twin_progress = Progress()
-        self.strategy = Rigid(self.twin, self.twin_progress, options)
+        self.strategy = Rigid(self.twin, self.twin_progress, options, predictor=True)
         self.steps = 0
 
     def begin(self) -> None:

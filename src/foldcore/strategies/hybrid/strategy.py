@@ -72,6 +72,8 @@ class Hybrid(Strategy):
         self._pending = True  # the next run starts with a rigid phase
         self._engine = None  # the rigid phase's strategy, built on the first run (False: none)
         self._start = None  # the rigid phase of a mesh in rings while it runs (RigidStart)
+        # slack hinges: the rigid phase holds their strips at their shortest, newton frees them
+        self._slack = bool(np.any(np.asarray(model.mesh.hinge_model) == "slack"))
 
     def _finishing(self) -> Strategy:
         """The strategy after (or instead of) the rigid phase: ``newton`` on a mesh whose
@@ -109,7 +111,8 @@ class Hybrid(Strategy):
             return  # a pull-and-release schedule: the rigid phase would settle before it fades
         if self._engine is None:
             try:
-                self._engine = Rigid(self.model, self.progress, self.options.rigid)
+                self._engine = Rigid(self.model, self.progress, self.options.rigid,
+                                     predictor=True)
             except SimulationError:
                 self._engine = False  # not a rigid-panel mesh: the finishing strategy
         if self._engine is False:
@@ -180,6 +183,8 @@ class Hybrid(Strategy):
         if coarse and not done and self._rigid_steps < o.rigid_max_steps:
             return False  # the twin's steps: it hands over itself when it stalls
         tiny = self.rigid.engine.stalls(moved, o.rigid_tol)
+        if done and self._slack:  # the rigid model's equilibrium, not the mesh's
+            done = False
         if done or tiny or self._rigid_steps >= o.rigid_max_steps:
             if not done:  # the run will not end at a rigid state: Newton takes over
                 self.rigid.hand_over()

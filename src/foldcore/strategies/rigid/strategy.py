@@ -42,6 +42,19 @@ def at_rest(model, x: np.ndarray, tolerance: float) -> bool:
     return not model.position_targets and gap <= tolerance * model.length_scale
 
 
+def refuse_slack(mesh) -> None:
+    """SimulationError where ``mesh`` has slack hinges: this strategy bends every strip
+    along a neutral axis of a length set by its angle, a slack strip's length is
+    free between bounds (:mod:`foldcore.hinges`); ``hybrid`` uses these steps as
+    its predictor and finishes such meshes with ``newton``."""
+    slack = np.flatnonzero(np.asarray(mesh.hinge_model) == "slack")
+    if len(slack):
+        listed = ", ".join(str(int(e)) for e in slack[:8]) + (" …" if len(slack) > 8 else "")
+        raise SimulationError(f"solver 'rigid' holds every hinge strip at the length its "
+                              f"angle sets; crease edges {listed} have slack hinges "
+                              f"(their length is free): use solver 'hybrid' or 'newton'")
+
+
 class Rigid(Strategy):
     """One Levenberg–Marquardt iteration per :meth:`step` (rejected steps count)."""
 
@@ -49,8 +62,10 @@ class Rigid(Strategy):
     Options = RigidOptions
     supports_contact = True
 
-    def __init__(self, model, progress, options=None):
+    def __init__(self, model, progress, options=None, predictor: bool = False):
         super().__init__(model, progress, options)
+        if not predictor:
+            refuse_slack(model.mesh)
         # SimulationError on meshes it cannot take
         self.engine = RigidBodySolver(model, progress, self.options)
         self._run = -1  # the run the engine's energy scale belongs to
