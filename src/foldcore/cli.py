@@ -217,7 +217,15 @@ def _add_solving(sim) -> None:
     sim.add_argument("--contact", choices=CONTACT_CHOICES, default="off",
                      help="on: panels no crease joins never pass through each other (IPC "
                           "barrier and collision-checked steps; needs --solver rigid and the "
-                          "ipctk package); default off")
+                          "ipctk package); default off, on with --obstacle or --ground")
+    sim.add_argument("--obstacle", action="append", default=[], metavar="MESH",
+                     help="a fixed obstacle the sheet touches but never passes: a mesh file "
+                          "(STL, OBJ, PLY, ... read by meshio) in mm in the pattern's frame "
+                          "(the flat sheet's mid-surface is z = 0); repeatable; turns contact "
+                          "on")
+    sim.add_argument("--ground", type=float, default=None, metavar="Z",
+                     help="a horizontal plane at height Z mm, facing up, the sheet never "
+                          "passes (the flat sheet's bottom face is at -H/2); turns contact on")
 
 
 def _add_outputs(sim) -> None:
@@ -343,7 +351,8 @@ def option_groups(args) -> dict:
                                      args.hinge, args.elastic_cells),
             "solving": Solving(args.fold_percent, args.solver, args.tolerance,
                                args.max_iterations, args.actuation, args.branch_floor,
-                               contact=args.contact),
+                               contact=args.contact, obstacles=tuple(args.obstacle),
+                               ground=args.ground),
             "outputs": Outputs(args.output, args.report, args.render, args.animate,
                                args.series, args.frames, args.fps)}
 

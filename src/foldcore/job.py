@@ -183,8 +183,24 @@ def _simulation(job: Job, loaded, thickness: float):
                    elastic="facets" if cells else None, cell_size=cells)
     sim = Simulation(mesh, loaded.pattern, solver=s.solver, actuation=s.actuation,
                      branch_floor_deg=s.branch_floor, options=s.strategy_options,
-                     contact=s.contact == "on")
+                     contact=s.contact_on, obstacles=_obstacles(s, loaded.pattern))
     return mesh, sim
+
+
+def _obstacles(s, pattern) -> list:
+    """The run's :class:`foldcore.contact.Obstacle` list: the mesh files, then the ground
+    (a square 20 × the pattern's size under its centre)."""
+    if not (s.obstacles or s.ground is not None):
+        return []
+    from .contact import Obstacle, read_obstacle
+
+    out = [read_obstacle(path) for path in s.obstacles]
+    if s.ground is not None:
+        lo, hi = pattern.vertices.min(axis=0), pattern.vertices.max(axis=0)
+        centre = 0.5 * (lo + hi)
+        out.append(Obstacle.plane((centre[0], centre[1], s.ground), (0.0, 0.0, 1.0),
+                                  size=20.0 * float((hi - lo).max()), name="ground"))
+    return out
 
 
 def _settings(job: Job, thickness: float, mesh, sim) -> dict:
@@ -195,7 +211,8 @@ def _settings(job: Job, thickness: float, mesh, sim) -> dict:
             "subdivisions": t.subdivisions, "thickness_mm": thickness,
             "hinge": sorted(set(mesh.hinge_model) - {""}), "actuation": s.actuation,
             "branch_floor_deg": s.branch_floor, "elastic_cells_mm": t.elastic_cells,
-            "contact": s.contact,
+            "contact": "on" if s.contact_on else "off",
+            "obstacles": list(s.obstacles), "ground_mm": s.ground,
             "backend": sim.system.backend}
 
 

@@ -108,6 +108,13 @@ class Solving:
     contact : {"off", "on"}
         ``"on"``: panels that no crease joins never pass through each other
         (:mod:`foldcore.contact`; strategies with ``supports_contact``: ``rigid``).
+        Obstacles turn it on.
+    obstacles : tuple of str
+        Mesh files (STL, OBJ, PLY, … in mm, the pattern's frame: the flat sheet's
+        mid-surface is z = 0) of fixed obstacles the sheet touches but never passes.
+    ground : float, optional
+        Height z (mm) of a horizontal plane facing up that the sheet never passes
+        (below −H/2: the flat sheet's bottom face).
     """
 
     fold_percent: float = 100.0
@@ -118,12 +125,28 @@ class Solving:
     branch_floor: float = BRANCH_FLOOR_DEG
     strategy_options: object = None
     contact: str = "off"
+    obstacles: tuple = ()
+    ground: float | None = None
+
+    @property
+    def contact_on(self) -> bool:
+        """Whether the run keeps panels apart: asked for, or obstacles to keep off."""
+        return self.contact == "on" or bool(self.obstacles) or self.ground is not None
 
     def __post_init__(self):
         _within(self.fold_percent, -100.0, 100.0, "solving.fold_percent")
         if self.contact not in CONTACT_CHOICES:
             raise OptionError(f"solving.contact must be one of {', '.join(CONTACT_CHOICES)}, "
                               f"got {self.contact!r}")
+        if self.ground is not None and not (isinstance(self.ground, (int, float))
+                                            and math.isfinite(self.ground)):
+            raise OptionError(f"solving.ground must be a finite height in mm, got "
+                              f"{self.ground!r}")
+        if isinstance(self.obstacles, (str, bytes)) or not all(
+                isinstance(o, (str, os.PathLike)) for o in self.obstacles):
+            raise OptionError(f"solving.obstacles must be a sequence of file paths, got "
+                              f"{self.obstacles!r}")
+        object.__setattr__(self, "obstacles", tuple(str(o) for o in self.obstacles))
         _positive(self.tolerance, "solving.tolerance", optional=False)
         _count(self.max_iterations, 1, None, "solving.max_iterations")
         if self.actuation not in ACTUATIONS:
@@ -212,6 +235,8 @@ FLAGS = {
     "solving.actuation": "--actuation",
     "solving.branch_floor": "--branch-floor",
     "solving.contact": "--contact",
+    "solving.obstacles": "--obstacle",
+    "solving.ground": "--ground",
     "outputs.fold": "-o",
     "outputs.report": "--report",
     "outputs.render": "--render",

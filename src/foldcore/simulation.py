@@ -81,7 +81,7 @@ class Simulation:
                  threads: int | None = None, strain_limits=None,
                  actuation: str = DEFAULT_ACTUATION,
                  branch_floor_deg: float = BRANCH_FLOOR_DEG, options=None,
-                 convergence=ConvergenceTest, contact=None):
+                 convergence=ConvergenceTest, contact=None, obstacles=()):
         start = time.perf_counter()
         try:
             strategy = strategies.get(solver)
@@ -101,7 +101,7 @@ class Simulation:
         self.model.timings["setup"] = time.perf_counter() - start
         self.convergence = convergence(self.model, self.progress)
         self._monitor = self._failure_monitor(strain_limits)
-        self.model.contact = contact_model(self.model, strategy, contact)
+        self.model.contact = contact_model(self.model, strategy, contact, obstacles)
         self._bare_solve = None  # (K version, seconds) of the last bare-solve timing
         self.strategy = strategy(self.model, self.progress, options)  # moves model.x
         self.model.subscribe(self._targets_changed)
@@ -421,9 +421,16 @@ class Simulation:
             raise SimulationError(str(exc)) from None
 
 
-def contact_model(model, strategy, contact):
+def contact_model(model, strategy, contact, obstacles=()):
     """The :class:`foldcore.contact.ContactModel` ``contact`` asks for (None, False:
-    none; True: default settings; a :class:`foldcore.contact.ContactSettings`)."""
+    none; True: default settings; a :class:`foldcore.contact.ContactSettings`), with
+    ``obstacles`` (:class:`foldcore.contact.Obstacle`; they turn contact on where it
+    is None). SimulationError where an obstacle touches a panel at the start."""
+    obstacles = list(obstacles or ())
+    if obstacles and contact is False:
+        raise SimulationError("obstacles need contact: drop contact=False")
+    if contact is None and obstacles:
+        contact = True
     if contact is None or contact is False:
         return None
     from .contact import ContactModel, ContactSettings
@@ -440,10 +447,20 @@ def contact_model(model, strategy, contact):
     if not model.mesh.thickness > 0:
         raise SimulationError("contact needs a sheet of thickness > 0")
     try:
-        return ContactModel(model.mesh, model.pattern, model.system.reference_weight, settings)
+        built = ContactModel(model.mesh, model.pattern, model.system.reference_weight,
+                             settings, obstacles)
     except ImportError:
         raise SimulationError("contact needs the ipctk package: pip install 'foldcore[contact]'") \
             from None
+    touching = built.obstacles_touching(model.x)
+    if touching:
+        face = model.mesh.groups[model.mesh.panel_group].source
+        p, o = touching[0]
+        raise SimulationError(f"obstacle {obstacles[o].name!r} touches or cuts the panel of "
+                              f"face {int(face[p])} at the start ({len(touching)} panel(s)); "
+                              f"move it clear of the sheet (its faces are at ±H/2 = "
+                              f"±{0.5 * model.mesh.thickness:g} mm)")
+    return built
 
 
 def contact_summary(model) -> dict | None:
@@ -454,11 +471,22 @@ def contact_summary(model) -> dict | None:
     state = contact.state(model.x)
     face = model.mesh.groups[model.mesh.panel_group].source
     forces = contact.forces(state)
-    touching = np.unique(state.pairs) if len(state.pairs) else np.zeros(0, dtype=np.int64)
+    touching = np.unique(np.concatenate([state.pairs.ravel(), state.obstacle_pairs[:, 0]]))
+    obstacles = [] if contact.obstacles is None else contact.obstacles.obstacles
+    pressed = contact.obstacle_forces(state)
     return {"active_pairs": face[state.pairs].tolist(),
-            "smallest_gap_mm": float(state.gaps.min()) if len(state.gaps) else None,
+            "obstacles": [{"name": o.name, "touching_faces": sorted(
+                              int(face[p]) for p, k in state.obstacle_pairs if k == i),
+                           "force": pressed[i].tolist(),
+                           "magnitude": float(np.linalg.norm(pressed[i]))}
+                          for i, o in enumerate(obstacles)],
+            "smallest_gap_mm": _smallest(np.concatenate([state.gaps, state.obstacle_gaps])),
             "activation_mm": contact.dhat, "stiffness": contact.kappa,
             "touching_faces": face[touching].tolist(),
             "panel_forces": [{"face": int(face[p]), "force": forces[p].tolist(),
                               "magnitude": float(np.linalg.norm(forces[p]))}
                              for p in touching]}
+
+
+def _smallest(values: np.ndarray) -> float | None:
+    return float(values.min()) if len(values) else None

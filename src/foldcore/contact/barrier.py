@@ -17,11 +17,12 @@ force, with the sign reversed) in mm⁴.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.sparse as sp
 
+from .obstacles import ObstacleContacts
 from .solids import PanelSolids
 
 #: Share of a straight-line step taken up to the first touch (IPC's 0.8–0.9).
@@ -30,6 +31,10 @@ CCD_RESCALING = 0.9
 #: (:meth:`~.solids.PanelSolids.shrunk`): faces that meet by design stay apart, and
 #: two joined panels can overlap by at most this share of their size.
 JOINED_SHARE = 2e-5
+#: κ doubles while the smallest gap of unjoined pairs is below this share of d̂ and
+#: shrinking (IPC's adaptive stiffness), up to ``MAX_STIFFENING`` × its start.
+TIGHT_GAP = 1e-3
+MAX_STIFFENING = 1e8
 
 
 def _ipctk():
@@ -71,14 +76,29 @@ class ContactState:
         Panel pairs with at least one primitive pair within d̂.
     gaps : (K,) float
         Each pair's smallest distance, mm.
+    joined : (K,) bool
+        Whether a crease joins the pair (they touch by design at a flat fold).
     energy : float
         κ Σ b over every active primitive pair, mm⁵.
+    obstacle_pairs : (L, 2) int
+        (panel, obstacle) pairs within d̂.
+    obstacle_gaps : (L,) float
+        Their smallest distances, mm.
     """
 
     pairs: np.ndarray
     gaps: np.ndarray
     energy: float
-    _terms: list  # (pair vertices (n,), collisions, collision mesh, local positions)
+    _terms: list  # (pair vertices (n,), collisions, collision mesh, local positions, …)
+    joined: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=bool))
+    obstacle_pairs: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), np.int64))
+    obstacle_gaps: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    _obstacle_of: list = field(default_factory=list)  # obstacle of each term (−1: panels)
+
+    @property
+    def active(self) -> bool:
+        """Whether any barrier term acts (between panels or with an obstacle)."""
+        return bool(self._terms)
 
 
 class ContactModel:
@@ -92,10 +112,12 @@ class ContactModel:
     reference_weight : float
         The model's reference weight (mm³): κ = ``settings.stiffness`` × it.
     settings : ContactSettings
+    obstacles : sequence of :class:`~.obstacles.Obstacle`
+        Fixed meshes the panels touch but never pass (:mod:`.obstacles`).
     """
 
     def __init__(self, mesh, pattern, reference_weight: float,
-                 settings: ContactSettings | None = None):
+                 settings: ContactSettings | None = None, obstacles=()):
         self.settings = settings or ContactSettings()
         self.solids = PanelSolids(mesh, pattern)
         self.dhat = self.settings.activation * float(mesh.thickness)
@@ -106,13 +128,37 @@ class ContactModel:
         self._rest = mesh.rest_positions
         self._meshes: dict = {}
         ipctk = _ipctk()
-        self._potential = {
-            False: ipctk.BarrierPotential(self.dhat, self.kappa),
-            # κ × d̂/d̂_j: a force at a gap of d̂_j/2 as large as κ's at d̂/2 … within a
-            # factor ln: of the variants tried (×1, ×d̂/d̂_j, ×(d̂/d̂_j)²) the fewest steps
-            True: ipctk.BarrierPotential(self.dhat_joined,
-                                         self.kappa * self.dhat / self.dhat_joined)}
+        self._potential = self._potentials()
         self._ccd = ipctk.AdditiveCCD(conservative_rescaling=CCD_RESCALING)
+        self.obstacles = ObstacleContacts(self.solids, obstacles, self._potential[False],
+                                          self._ccd) if len(obstacles) else None
+        self._kappa_start, self._last_gap = self.kappa, np.inf
+
+    def _potentials(self) -> dict:
+        """The barrier potentials of unjoined (False) and joined (True) pairs at κ."""
+        ipctk = _ipctk()
+        return {False: ipctk.BarrierPotential(self.dhat, self.kappa),
+                # κ × d̂/d̂_j: a force at a gap of d̂_j/2 as large as κ's at d̂/2 … within a
+                # factor ln: of the variants tried (×1, ×d̂/d̂_j, ×(d̂/d̂_j)²) the fewest steps
+                True: ipctk.BarrierPotential(self.dhat_joined,
+                                             self.kappa * self.dhat / self.dhat_joined)}
+
+    def stiffen(self, state: "ContactState") -> bool:
+        """IPC's adaptive stiffness: doubles κ where the smallest gap of unjoined pairs
+        and obstacles at ``state`` is below ``TIGHT_GAP`` × d̂ and smaller than at the
+        last call (a load the barrier holds only at a vanishing gap, where every step
+        is cut short); True when κ changed (energies at earlier states are stale)."""
+        gaps = np.concatenate([state.gaps[~state.joined], state.obstacle_gaps])
+        gap = float(gaps.min()) if len(gaps) else np.inf
+        last, self._last_gap = self._last_gap, gap
+        if not (gap < TIGHT_GAP * self.dhat and gap < last) or \
+                self.kappa >= MAX_STIFFENING * self._kappa_start:
+            return False
+        self.kappa *= 2.0
+        self._potential = self._potentials()
+        if self.obstacles is not None:
+            self.obstacles.potential = self._potential[False]
+        return True
 
     # -------------------------------------------------------------- pairs
     def candidates(self, x: np.ndarray, margin: float) -> np.ndarray:
@@ -160,7 +206,7 @@ class ContactModel:
     def state(self, x: np.ndarray) -> ContactState:
         """The contacts at positions x (N, 3)."""
         ipctk = _ipctk()
-        pairs, gaps, energy, terms = [], [], 0.0, []
+        pairs, gaps, energy, terms, kinds = [], [], 0.0, [], []
         for joined, candidates, positions in self._pairs(x):
             dhat, potential = (self.dhat_joined if joined else self.dhat), self._potential[joined]
             for a, b in candidates:
@@ -171,11 +217,23 @@ class ContactModel:
                 if not len(collisions):
                     continue
                 pairs.append((a, b))
+                kinds.append(joined)
                 gaps.append(np.sqrt(collisions.compute_minimum_distance(mesh, local)))
                 energy += float(potential(collisions, mesh, local))
                 terms.append((ids, collisions, mesh, local, potential, pull))
         pairs = np.array(pairs, dtype=np.int64).reshape(-1, 2)
-        return ContactState(pairs, np.array(gaps, dtype=float), energy, terms)
+        state = ContactState(pairs, np.array(gaps, dtype=float), energy, terms,
+                             joined=np.array(kinds, dtype=bool), _obstacle_of=[-1] * len(terms))
+        if self.obstacles is not None:
+            found, pairs, gaps = self.obstacles.terms(x, self.dhat)
+            for o, term in found:
+                ids, collisions, mesh, local, potential, _ = term
+                state.energy += float(potential(collisions, mesh, local))
+                state._terms.append(term)
+                state._obstacle_of.append(o)
+            state.obstacle_pairs = np.array(pairs, dtype=np.int64).reshape(-1, 2)
+            state.obstacle_gaps = np.array(gaps, dtype=float)
+        return state
 
     def gradient(self, state: ContactState) -> np.ndarray:
         """(N, 3) ∂(κ Σ b)/∂x at a state's positions, mm⁴."""
@@ -233,6 +291,8 @@ class ContactModel:
                 mesh, np.asfortranarray(x0[ids]), np.asfortranarray(x1[ids]),
                 narrow_phase_ccd=self._ccd)
             fraction = min(fraction, float(t))
+        if self.obstacles is not None:
+            fraction = min(fraction, self.obstacles.free_fraction(x0, x1))
         shrunk = s.shrunk(x1, JOINED_SHARE)
         for a, b in self._joined_near(shrunk, 0.0):
             mesh, ids, _ = self._pair_mesh(int(a), int(b), True)
@@ -250,6 +310,22 @@ class ContactModel:
             if ipctk.has_intersections(mesh, np.asfortranarray(x[ids])):
                 found.append((a, b))
         return np.array(found, dtype=np.int64).reshape(-1, 2)
+
+    def obstacles_touching(self, x: np.ndarray) -> list:
+        """[(panel, obstacle)] intersecting or touching at x (empty without obstacles)."""
+        return [] if self.obstacles is None else self.obstacles.touching(x)
+
+    def obstacle_forces(self, state: ContactState) -> np.ndarray:
+        """(n_obstacles, 3) force the panels press each obstacle with (Σ of the
+        barrier's gradient on the panels' vertices of its terms), mm⁴."""
+        n = 0 if self.obstacles is None else len(self.obstacles.obstacles)
+        out = np.zeros((n, 3))
+        for o, (ids, collisions, mesh, local, potential, pull) in zip(state._obstacle_of,
+                                                                       state._terms):
+            if o >= 0:
+                g = pull.T @ potential.gradient(collisions, mesh, local)
+                out[o] += g.reshape(-1, 3).sum(axis=0)
+        return out
 
     def forces(self, state: ContactState) -> np.ndarray:
         """(n_panels, 3) contact force on each panel (−Σ of its vertices' barrier

@@ -128,7 +128,10 @@ class RigidBodySolver:
         sign = params[:, SIGN]
         hi = np.where(sign < 0, -params[:, FLOOR], params[:, MAX_ANGLE])
         lo = np.where(sign > 0, params[:, FLOOR], -params[:, MAX_ANGLE])
-        pinned = bool(self.model.position_targets)
+        # position targets or obstacles hold the rigid motion: no panel is fixed
+        contact = self.model.contact
+        pinned = bool(self.model.position_targets) or (
+            contact is not None and contact.obstacles is not None)
         relayout = lay.pinned != pinned  # which panel is fixed
         if lay.passive is None or relayout or not np.array_equal(passive, lay.passive):
             self._new_passive(passive, pinned, sign)

@@ -183,12 +183,16 @@ class ResidualModel:
             self._contact_at = (x.copy(), contact.state(x))
         return self._contact_at[1]
 
+    def forget_contact(self) -> None:
+        """The contact model changed (its stiffness): the next evaluation is anew."""
+        self._contact_at = None
+
     def contact_terms(self, state, with_hessian: bool):
         """(½ Pᵀ∇C (n_q,), lower triangle of ½ PᵀHP as COO or None) of the contact
         energy C at a state, P = ∂x/∂(panel, free-vertex unknowns); None when
         nothing touches. ½: the step's energy is rᵀr, its gradient Jᵀr."""
         contact = self.contact_state(state.x)
-        if contact is None or not len(contact.pairs):
+        if contact is None or not contact.active:
             return None
         model = self.model.contact
         p_map = self.kinematics.position_map(state)
@@ -269,8 +273,9 @@ class ResidualModel:
         lin = Linearisation(lay, self.sqrt_w, state, residual, self.strip_targets,
                             self.angle_columns(state.rot_e), self.extra_rows(state))
         contact = self.contact_state(state.x)
-        if contact is not None and len(contact.pairs):
-            lay.add_contact_pairs(contact.pairs)
+        if contact is not None and contact.active:
+            if len(contact.pairs):
+                lay.add_contact_pairs(contact.pairs)
             lin.contact_energy = contact.energy
         data = np.zeros(len(lay.csc_indices))
         lin.grad = np.zeros(lay.n_unknowns)

@@ -106,6 +106,7 @@ class LevenbergMarquardt:
         engine, o = self.engine, self.options
         residual_model, kin = engine.residual, engine.kinematics
         start = engine.state()
+        self.adapt_contact(start)
         lin = residual_model.linearise(start)
         res, grad = lin.residual, lin.grad
         energy = float(res @ res) + lin.contact_energy
@@ -146,6 +147,15 @@ class LevenbergMarquardt:
         self.energy_after = new_energy if self.accepted else energy  # not E − decrease: that
         #   rounds to 0 where the step took E from 1.9e-7 to 8e-24
         return energy, moved
+
+    def adapt_contact(self, start) -> None:
+        """Stiffen the barrier where a contact holds only at a vanishing gap
+        (:meth:`foldcore.contact.ContactModel.stiffen`); energies are then taken anew."""
+        contact = self.engine.model.contact
+        if contact is None:
+            return
+        if contact.stiffen(self.engine.residual.contact_state(start.x)):
+            self.engine.residual.forget_contact()
 
     def crosses(self, start, trial) -> float | None:
         """None when the straight-line motion from ``start`` to ``trial`` brings no two
