@@ -216,8 +216,9 @@ def _add_solving(sim) -> None:
                           f"(branch selection; 0 turns it off; default {BRANCH_FLOOR_DEG:g})")
     sim.add_argument("--contact", choices=CONTACT_CHOICES, default="off",
                      help="on: panels no crease joins never pass through each other (IPC "
-                          "barrier and collision-checked steps; needs --solver rigid and the "
-                          "ipctk package); default off, on with --obstacle or --ground")
+                          "barrier and collision-checked steps; solvers hybrid, rigid, "
+                          "newton; needs the ipctk package); default off, on with "
+                          "--obstacle or --ground")
     sim.add_argument("--obstacle", action="append", default=[], metavar="MESH",
                      help="a fixed obstacle the sheet touches but never passes: a mesh file "
                           "(STL, OBJ, PLY, ... read by meshio) in mm in the pattern's frame "

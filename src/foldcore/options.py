@@ -107,7 +107,8 @@ class Solving:
         The strategy's own options (its ``Options`` class).
     contact : {"off", "on"}
         ``"on"``: panels that no crease joins never pass through each other
-        (:mod:`foldcore.contact`; strategies with ``supports_contact``: ``rigid``).
+        (:mod:`foldcore.contact`; strategies with ``supports_contact``: ``hybrid``,
+        ``rigid``, ``newton``).
         Obstacles turn it on.
     obstacles : tuple of str
         Mesh files (STL, OBJ, PLY, … in mm, the pattern's frame: the flat sheet's

@@ -446,6 +446,8 @@ def contact_model(model, strategy, contact, obstacles=()):
                               f"contact needs one of {supported}")
     if not model.mesh.thickness > 0:
         raise SimulationError("contact needs a sheet of thickness > 0")
+    if model.mesh.panel_group != "rigid_panel":
+        raise SimulationError("contact needs rigid panels (this mesh's are elastic cells)")
     try:
         built = ContactModel(model.mesh, model.pattern, model.system.reference_weight,
                              settings, obstacles)

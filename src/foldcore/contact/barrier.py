@@ -176,12 +176,15 @@ class ContactModel:
             return pairs
         return pairs[self.solids.gap_bounds(shrunk, pairs, self.solids.joined_edge) < margin]
 
-    def _pairs(self, x: np.ndarray):
+    def _pairs(self, x: np.ndarray, joined: bool):
         """[(joined, pairs, positions)] to evaluate at x: unjoined pairs within d̂ on
-        the panels as they are, joined pairs within their d̂ on the shrunk panels."""
-        shrunk = self.solids.shrunk(x, JOINED_SHARE)
-        return [(False, self.candidates(x, self.dhat), x),
-                (True, self._joined_near(shrunk, self.dhat_joined), shrunk)]
+        the panels as they are, joined pairs (where ``joined``) within their d̂ on
+        the shrunk panels."""
+        out = [(False, self.candidates(x, self.dhat), x)]
+        if joined:
+            shrunk = self.solids.shrunk(x, JOINED_SHARE)
+            out.append((True, self._joined_near(shrunk, self.dhat_joined), shrunk))
+        return out
 
     def _pair_mesh(self, a: int, b: int, joined: bool):
         """(collision mesh, model vertex ids, pull-back) of panels a and b, cached; the
@@ -203,11 +206,13 @@ class ContactModel:
         return self._meshes[key]
 
     # -------------------------------------------------------- the barrier
-    def state(self, x: np.ndarray) -> ContactState:
-        """The contacts at positions x (N, 3)."""
+    def state(self, x: np.ndarray, joined: bool = True) -> ContactState:
+        """The contacts at positions x (N, 3); ``joined``: also between panels a crease
+        joins (a strategy with exactly rigid panels; otherwise their hinge holds
+        them)."""
         ipctk = _ipctk()
         pairs, gaps, energy, terms, kinds = [], [], 0.0, [], []
-        for joined, candidates, positions in self._pairs(x):
+        for joined, candidates, positions in self._pairs(x, joined):
             dhat, potential = (self.dhat_joined if joined else self.dhat), self._potential[joined]
             for a, b in candidates:
                 mesh, ids, pull = self._pair_mesh(int(a), int(b), joined)
@@ -243,14 +248,20 @@ class ContactModel:
             out[ids] += (g if pull is None else pull.T @ g).reshape(-1, 3)
         return out
 
-    def hessian(self, state: ContactState) -> sp.csr_matrix:
-        """(3N, 3N) PSD-projected ∂²(κ Σ b)/∂x², mm³ (each pair's block clamped)."""
+    def hessian_blocks(self, state: ContactState):
+        """Each barrier term's (model vertex ids (n,), PSD-projected block of
+        ∂²(κ Σ b)/∂x² over their dofs, (3n, 3n) sparse, mm³)."""
         ipctk = _ipctk()
-        rows, cols, vals = [], [], []
         for ids, collisions, mesh, local, potential, pull in state._terms:
             block = potential.hessian(collisions, mesh, local, ipctk.PSDProjectionMethod.CLAMP)
             if pull is not None:
                 block = sp.coo_matrix(pull.T @ block.toarray() @ pull)
+            yield ids, block
+
+    def hessian(self, state: ContactState) -> sp.csr_matrix:
+        """(3N, 3N) PSD-projected ∂²(κ Σ b)/∂x², mm³ (each pair's block clamped)."""
+        rows, cols, vals = [], [], []
+        for ids, block in self.hessian_blocks(state):
             block = block.tocoo()
             dof = (3 * ids[:, None] + np.arange(3)).ravel()
             rows.append(dof[block.row])
@@ -263,7 +274,7 @@ class ContactModel:
                                                      np.concatenate(cols))), shape=(n, n))
 
     # ------------------------------------------------------------- steps
-    def free_fraction(self, x0: np.ndarray, x1: np.ndarray) -> float:
+    def free_fraction(self, x0: np.ndarray, x1: np.ndarray, joined: bool = True) -> float:
         """A share t ∈ [0, 1] of the step x0 → x1 that brings no two panels into
         contact; 1 where nothing comes near. x0 must be intersection-free.
 
@@ -274,7 +285,8 @@ class ContactModel:
         hinge keeps their faces a hair apart; their shrunk geometry is checked
         at x1 instead (½ where it intersects): two panels a hinge joins cannot
         pass through each other without intersecting on the way, and a step is
-        a small turn of that hinge."""
+        a small turn of that hinge. ``joined`` False leaves them out (a strategy
+        whose panels are not exactly rigid: their hinge holds them)."""
         s = self.solids
         if not s.n_panels:
             return 1.0
@@ -293,6 +305,8 @@ class ContactModel:
             fraction = min(fraction, float(t))
         if self.obstacles is not None:
             fraction = min(fraction, self.obstacles.free_fraction(x0, x1))
+        if not joined:
+            return fraction
         shrunk = s.shrunk(x1, JOINED_SHARE)
         for a, b in self._joined_near(shrunk, 0.0):
             mesh, ids, _ = self._pair_mesh(int(a), int(b), True)

@@ -55,6 +55,7 @@ from elements.bending_hinge import MODEL, SLACK
 from ..errors import SimulationError
 from ..linsolve import Factor
 from .base import Strategy
+from .vertex_contact import VertexContact
 
 ROUNDING = 64 * np.finfo(float).eps  # energy change (share of the run's largest) that is noise
 SUPPORTED = {"rigid_panel", "bending_hinge"}  # groups whose projections turn a fixed shape
@@ -101,6 +102,7 @@ class Newton(Strategy):
 
     name = "newton"
     Options = NewtonOptions
+    supports_contact = True
 
     def __init__(self, model, progress, options=None):
         super().__init__(model, progress, options)
@@ -121,7 +123,8 @@ class Newton(Strategy):
                              * (ROUNDING * model.length_scale) ** 2)
 
         self._at = None  # the accepted trial's projections, reused by the next step
-        self.hessian_pattern = None  # HessianPattern of the current K
+        self.contact = VertexContact(model) if model.contact is not None else None
+        self.hessian_pattern = None  # HessianPattern of the current K (and contact blocks)
         self._factor = None  # Factor of H + λ D, refactored in place while the pattern holds
 
     def restart(self) -> None:
@@ -134,17 +137,28 @@ class Newton(Strategy):
     def step(self) -> tuple[float, float]:
         model, o = self.model, self.options
         x = model.x
-        energy, rhs, targets = self._projections(x)
+        energy, rhs, targets, touch = self._projections(x)
         self.energy_max = max(self.energy_max, energy)
         noise = ROUNDING * self.energy_max + self.energy_floor  # changes that count as none
         gradient = (model.system.apply(x) - rhs).ravel()
-        hessian = self.hessian(targets)
+        if touch is not None:
+            gradient = gradient + self.contact.gradient(touch)
+        hessian = self.hessian(targets, touch)
         while True:
             delta = self._solve(hessian, -gradient).reshape(-1, 3)
-            if not model.position_targets:
+            if not (model.position_targets or (self.contact and
+                                               self.contact.holds_rigid_motion)):
                 delta = _without_rigid_motion(delta, x)
             trial = self._corrected(x + delta)
-            trial_energy, trial_rhs = model.local_step(trial)
+            if self.contact is not None:
+                trial = self.contact.collision_free(x, trial)
+                if trial is x:  # no share of the step is free: a shorter one may be
+                    trial_energy, trial_rhs = np.inf, None
+            if trial is not x:
+                trial_energy, trial_rhs = model.local_step(trial)
+            trial_touch = None if self.contact is None else self.contact.state(trial, adapt=False)
+            if trial_touch is not None:
+                trial_energy += trial_touch.energy
             if trial_energy <= energy + noise:
                 self.accepted, self.undamped = True, self.lam <= o.lambda_settled
                 self.lam = max(self.lam / o.lambda_down, o.lambda_min)
@@ -159,18 +173,26 @@ class Newton(Strategy):
         self.level = self.level + 1 if abs(energy - trial_energy) <= noise else 0
         self.energy = trial_energy
         self._at = (trial, trial_energy, trial_rhs.copy(), model.slot_targets.copy(),
-                    model.system.version)
+                    model.system.version, trial_touch)
         model.x = trial
         return energy, moved
 
     def _projections(self, x: np.ndarray):
-        """(E, b, slot targets) at ``x``: kept from the step that accepted ``x`` while
-        K is the same (a stop that closed there refactors it), else projected anew."""
+        """(E, b, slot targets, contacts or None) at ``x``: kept from the step that
+        accepted ``x`` while K is the same (a stop that closed there refactors it) and
+        the barrier's stiffness holds, else projected anew. E includes the barrier's."""
         at, self._at = self._at, None
+        if self.contact is not None:
+            touch = self.contact.state(x)  # κ may stiffen: then E is taken anew
+            if at is not None and at[0] is x and at[4] == self.model.system.version \
+                    and touch.energy == at[5].energy:
+                return at[1], at[2], at[3], touch
+            energy, rhs = self.model.local_step(x)
+            return energy + touch.energy, rhs, self.model.slot_targets, touch
         if at is not None and at[0] is x and at[4] == self.model.system.version:
-            return at[1], at[2], at[3]
+            return at[1], at[2], at[3], None
         energy, rhs = self.model.local_step(x)
-        return energy, rhs, self.model.slot_targets
+        return energy, rhs, self.model.slot_targets, None
 
     def settled(self, moved: float, limit: float) -> bool:
         """An accepted step, damped at most ``lambda_settled``, within ``limit`` mm,
@@ -207,17 +229,24 @@ class Newton(Strategy):
             x = self.model.global_step(rhs)
         return x
 
-    def hessian(self, targets: np.ndarray) -> np.ndarray:
-        """Values of H = K ⊗ I₃ − Σ w Q Qᵀ at the projections ``targets`` (nnz, 3) mm, in
-        the fixed pattern of :class:`HessianPattern` (built anew when K changes)."""
+    def hessian(self, targets: np.ndarray, touch=None) -> np.ndarray:
+        """Values of H = K ⊗ I₃ − Σ w Q Qᵀ (+ ½∇²C of the contacts ``touch``) at the
+        projections ``targets`` (nnz, 3) mm, in the fixed pattern of
+        :class:`HessianPattern` (built anew when K changes or a contact block joins)."""
         system = self.model.system
         bases = list(self.rotation_bases(targets))
-        if self.hessian_pattern is None or self.hessian_pattern.version != system.version:
-            self.hessian_pattern = HessianPattern(system, [ids for ids, _, _ in bases])
+        ids = [ids for ids, _, _ in bases]
+        blocks = [-weights[:, None, None] * np.matmul(basis, basis.transpose(0, 2, 1))
+                  for _, weights, basis in bases]
+        version = (system.version, 0)
+        if touch is not None:
+            runs, values = self.contact.blocks(touch)
+            ids, blocks = ids + runs, blocks + values
+            version = (system.version, self.contact.version)
+        if self.hessian_pattern is None or self.hessian_pattern.version != version:
+            self.hessian_pattern = HessianPattern(system, ids, version)
             self._factor = None
-        return self.hessian_pattern.values([-weights[:, None, None]
-                                     * np.matmul(basis, basis.transpose(0, 2, 1))
-                                     for _, weights, basis in bases])
+        return self.hessian_pattern.values(blocks)
 
     def _solve(self, values: np.ndarray, rhs: np.ndarray) -> np.ndarray:
         """(H + λ D)⁻¹ rhs, D the diagonal of K ⊗ I₃; the factor keeps its symbolic
@@ -295,10 +324,12 @@ class HessianPattern:
     blocks : list of (n, m) int arrays
         Vertex ids of each run of elements of size m, in the order their
         values will be given to :meth:`values`.
+    version : tuple, optional
+        What the pattern was built for (K's version, the contact blocks' count).
     """
 
-    def __init__(self, system, blocks):
-        self.version = system.version
+    def __init__(self, system, blocks, version=None):
+        self.version = (system.version, 0) if version is None else version
         base = sp.kron(system.with_pins(), sp.identity(3), format="coo")
         rows, cols = [base.row], [base.col]
         for ids in blocks:

@@ -61,10 +61,11 @@ class Hybrid(Strategy):
 
     name = "hybrid"
     Options = HybridOptions
+    supports_contact = True  # both phases keep panels apart (rigid, newton)
 
     def __init__(self, model, progress, options=None):
         super().__init__(model, progress, options)
-        self.finish = self._finishing()  # L-BFGS, or Newton on elastic cells
+        self.finish = self._finishing()  # L-BFGS, or Newton on elastic cells / with contact
         self._default_finish = self.finish
         self._newton = None  # the finish after a rigid phase hands over (False: refused)
         self.rigid = None  # the rigid phase's strategy while it runs
@@ -77,10 +78,11 @@ class Hybrid(Strategy):
 
     def _finishing(self) -> Strategy:
         """The strategy after (or instead of) the rigid phase: ``newton`` on a mesh whose
-        elastic faces are all in rings, else ``lbfgs`` (from rest ``newton`` turns
-        panels of bars and plates by small linear steps)."""
+        elastic faces are all in rings or that keeps panels apart (contact), else
+        ``lbfgs`` (from rest ``newton`` turns panels of bars and plates by small linear
+        steps)."""
         o = self.options
-        if in_rings(self.model.mesh):
+        if in_rings(self.model.mesh) or self.model.contact is not None:  # lbfgs lets panels cross
             return Newton(self.model, self.progress, o.newton)
         return Lbfgs(self.model, self.progress, o.lbfgs)
 
@@ -182,7 +184,8 @@ class Hybrid(Strategy):
         o = self.options
         if coarse and not done and self._rigid_steps < o.rigid_max_steps:
             return False  # the twin's steps: it hands over itself when it stalls
-        tiny = self.rigid.engine.stalls(moved, o.rigid_tol)
+        # with contact a step cut short by CCD is tiny without the phase being over
+        tiny = self.rigid.engine.stalls(moved, o.rigid_tol) and self.model.contact is None
         if done and self._slack:  # the rigid model's equilibrium, not the mesh's
             done = False
         if done or tiny or self._rigid_steps >= o.rigid_max_steps:
