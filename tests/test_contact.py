@@ -124,6 +124,23 @@ def test_a_contact_that_never_engages_changes_nothing():
     assert runs[1].contact["active_pairs"] == []
 
 
+def test_panels_sharing_points_with_their_strips_do_not_read_as_touching():
+    """A Miura's panels share points with their hinge strips along straight runs of
+    their outlines; those points are left out of the contact solids (their
+    zero-area triangles read as intersections, which stopped every step). Driven
+    to facet tilt 60°, no unjoined panels come near, and the zig-zag creases'
+    panels meet only at their axis hinges' pivot (119°, below the 150° from which
+    joined panels are checked): the fold is the one without contact, within the
+    run's tolerance (1e-8 × 67 mm over 20 mm panels: 2e-6°)."""
+    pattern = patterns.miura(3, 3, a=20.0, b=20.0, gamma=60.0)
+    pattern = pattern.replace(fold_angles=patterns.miura_fold_angles(3, 3, 60.0, 60.0))
+    mesh = thicken(pattern, H)
+    runs = [Simulation(mesh, pattern, contact=c).run(tolerance=1e-8) for c in (False, True)]
+    assert all(r.converged for r in runs)
+    np.testing.assert_allclose(runs[1].fold_angles_deg, runs[0].fold_angles_deg, atol=2e-6)
+    assert runs[1].contact["active_pairs"] == []
+
+
 def test_a_step_through_a_panel_is_cut_short_of_it(letter_runs):
     mesh, sim, result = letter_runs[True]
     contact = sim.model.contact

@@ -34,6 +34,12 @@ JOINED_SHARE = 2e-5
 #: κ doubles while the smallest gap of unjoined pairs is below this share of d̂ and
 #: shrinking (IPC's adaptive stiffness), up to ``MAX_STIFFENING`` × its start.
 TIGHT_GAP = 1e-3
+#: Joined panels are checked once their crease is folded past this angle (their
+#: normals' dot below its cosine), toward a flat fold: before, their hinge holds them, and
+#: an axis hinge turning into its pivot lets their inner edges meet within less
+#: than the shrunk geometry's margin (a Miura's zig-zag creases past 2·atan(W/H)).
+JOINED_FROM_DEG = 150.0
+JOINED_FROM = float(np.cos(np.radians(JOINED_FROM_DEG)))
 MAX_STIFFENING = 1e8
 
 
@@ -170,11 +176,18 @@ class ContactModel:
         return pairs
 
     def _joined_near(self, shrunk: np.ndarray, margin: np.ndarray | float) -> np.ndarray:
-        """(K, 2) joined pairs whose shrunk panels are not proved ``margin`` apart."""
-        pairs = self.solids.joined_pairs
+        """(K, 2) joined pairs folded past ``JOINED_FROM_DEG`` (their normals' dihedral)
+        whose shrunk panels are not proved ``margin`` apart."""
+        s = self.solids
+        pairs = s.joined_pairs
         if not len(pairs):
             return pairs
-        return pairs[self.solids.gap_bounds(shrunk, pairs, self.solids.joined_edge) < margin]
+        normal, _ = s.normals(shrunk)
+        folded = np.einsum("ij,ij->i", normal[pairs[:, 0]], normal[pairs[:, 1]]) < JOINED_FROM
+        pairs, edges = pairs[folded], s.joined_edge[folded]
+        if not len(pairs):
+            return pairs
+        return pairs[s.gap_bounds(shrunk, pairs, edges) < margin]
 
     def _pairs(self, x: np.ndarray, joined: bool):
         """[(joined, pairs, positions)] to evaluate at x: unjoined pairs within d̂ on

@@ -35,7 +35,8 @@ class PanelSolids:
     ----------
     n_panels : int
     vertices : (n,) int64
-        Model vertex ids of every panel, panel by panel.
+        Model vertex ids of every panel's corners (top loop, then bottom), panel
+        by panel.
     ptr : (n_panels + 1,) int64
         Panel p's vertices are ``vertices[ptr[p]:ptr[p + 1]]``.
     triangles : list of (T_p, 3) int32
@@ -49,7 +50,8 @@ class PanelSolids:
     def __init__(self, mesh, pattern):
         group = mesh.groups.get(mesh.panel_group)
         self.n_panels = len(group) if group is not None else 0
-        ids = [group.indices[group.slots(p)] for p in range(self.n_panels)]
+        ids = [_corners(group.indices[group.slots(p)], mesh.rest_positions)
+               for p in range(self.n_panels)]
         sizes = np.array([len(i) for i in ids], dtype=np.int64)
         self.vertices = np.concatenate(ids).astype(np.int64) if ids else np.zeros(0, np.int64)
         self.ptr = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
@@ -223,6 +225,19 @@ class PanelSolids:
         """Model vertex ids of panels a then b."""
         return np.concatenate([self.vertices[self.ptr[a]:self.ptr[a + 1]],
                                self.vertices[self.ptr[b]:self.ptr[b + 1]]])
+
+
+def _corners(ids: np.ndarray, rest: np.ndarray) -> np.ndarray:
+    """A prism's vertex ids (top loop, then bottom) without the points on straight
+    runs of its loop: a panel shares such points with its hinge strips, and the
+    zero-area triangles they leave in a triangulation read as intersections to
+    a collision check. The solid is the same."""
+    n = len(ids) // 2
+    top = rest[ids[:n]]
+    before, after = top - np.roll(top, 1, axis=0), np.roll(top, -1, axis=0) - top
+    turn = np.linalg.norm(np.cross(before, after), axis=1)
+    keep = turn > 1e-9 * np.linalg.norm(before, axis=1) * np.linalg.norm(after, axis=1)
+    return np.concatenate([ids[:n][keep], ids[n:][keep]])
 
 
 def _ranges(starts: np.ndarray, counts: np.ndarray) -> np.ndarray:
