@@ -19,7 +19,7 @@ import pytest
 
 pytest.importorskip("ipctk")
 
-from foldcore.contact import ContactSettings  # noqa: E402
+from foldcore.contact import ContactSettings, PanelSolids  # noqa: E402
 from foldcore.contact.barrier import JOINED_SHARE  # noqa: E402
 from foldcore.errors import SimulationError  # noqa: E402
 from foldcore.options import OptionError, Solving  # noqa: E402
@@ -139,6 +139,27 @@ def test_panels_sharing_points_with_their_strips_do_not_read_as_touching():
     assert all(r.converged for r in runs)
     np.testing.assert_allclose(runs[1].fold_angles_deg, runs[0].fold_angles_deg, atol=2e-6)
     assert runs[1].contact["active_pairs"] == []
+
+
+def test_a_thick_miura_driven_flat_stops_where_its_panels_meet_and_says_so():
+    """Equal axis hinges give a thick Miura no flat state (they bind); with contact
+    its panels meet before that (joined panels past 150° whose faces would cross),
+    and the report names the creases contact stopped. Without contact the same
+    run ends with two panels through each other by more than 1 % of a panel."""
+    from foldcore.outputs import actuation_entries
+
+    pattern = patterns.miura(3, 3, a=20.0, b=20.0, gamma=60.0)
+    pattern = pattern.replace(fold_angles=patterns.miura_fold_angles(3, 3, 60.0, 90.0))
+    mesh = thicken(pattern, H)
+    free, held = (Simulation(mesh, pattern, contact=c).run(tolerance=1e-8) for c in (False, True))
+    assert max(overlap_shares(mesh, free.positions).values()) > 0.01
+    entries = actuation_entries(held, pattern)
+    assert entries["contact_blocked"] and held.contact["blocking_pairs"]
+    source = mesh.groups[mesh.panel_group].source
+    joined = {tuple(sorted(int(source[p]) for p in pair))
+              for pair in PanelSolids(mesh, pattern).joined_pairs}
+    unjoined = {k: v for k, v in overlap_shares(mesh, held.positions).items() if k not in joined}
+    assert not unjoined or max(unjoined.values()) <= OVERLAP_SHARE, unjoined
 
 
 def test_a_step_through_a_panel_is_cut_short_of_it(letter_runs):

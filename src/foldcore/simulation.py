@@ -473,10 +473,13 @@ def contact_summary(model) -> dict | None:
     state = contact.state(model.x)
     face = model.mesh.groups[model.mesh.panel_group].source
     forces = contact.forces(state)
-    touching = np.unique(np.concatenate([state.pairs.ravel(), state.obstacle_pairs[:, 0]]))
+    blocking = np.array(contact.blocking, dtype=np.int64).reshape(-1, 2)
+    touching = np.unique(np.concatenate([state.pairs.ravel(), state.obstacle_pairs[:, 0],
+                                         blocking.ravel()]))
     obstacles = [] if contact.obstacles is None else contact.obstacles.obstacles
     pressed = contact.obstacle_forces(state)
     return {"active_pairs": face[state.pairs].tolist(),
+            "blocking_pairs": face[blocking].tolist(),
             "obstacles": [{"name": o.name, "touching_faces": sorted(
                               int(face[p]) for p, k in state.obstacle_pairs if k == i),
                            "force": pressed[i].tolist(),

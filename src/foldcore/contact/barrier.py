@@ -139,6 +139,8 @@ class ContactModel:
         self.obstacles = ObstacleContacts(self.solids, obstacles, self._potential[False],
                                           self._ccd) if len(obstacles) else None
         self._kappa_start, self._last_gap = self.kappa, np.inf
+        #: panel pairs that cut the last step checked (:meth:`free_fraction`) short
+        self.blocking: list = []
 
     def _potentials(self) -> dict:
         """The barrier potentials of unjoined (False) and joined (True) pairs at κ."""
@@ -301,6 +303,7 @@ class ContactModel:
         a small turn of that hinge. ``joined`` False leaves them out (a strategy
         whose panels are not exactly rigid: their hinge holds them)."""
         s = self.solids
+        self.blocking = []
         if not s.n_panels:
             return 1.0
         lo0, hi0 = s.boxes(x0)
@@ -316,6 +319,8 @@ class ContactModel:
                 mesh, np.asfortranarray(x0[ids]), np.asfortranarray(x1[ids]),
                 narrow_phase_ccd=self._ccd)
             fraction = min(fraction, float(t))
+            if t < 1.0:
+                self.blocking.append((int(a), int(b)))
         if self.obstacles is not None:
             fraction = min(fraction, self.obstacles.free_fraction(x0, x1))
         if not joined:
@@ -324,6 +329,7 @@ class ContactModel:
         for a, b in self._joined_near(shrunk, 0.0):
             mesh, ids, _ = self._pair_mesh(int(a), int(b), True)
             if ipctk.has_intersections(mesh, np.asfortranarray(shrunk[ids])):
+                self.blocking.append((int(a), int(b)))
                 return min(fraction, 0.5)
         return fraction
 
