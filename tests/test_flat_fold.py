@@ -164,11 +164,14 @@ def layers(frame):
     return np.sort([p.mean(axis=0) @ normal for p in points.values()])
 
 
-def test_pehrsons_vertex_folds_flat_in_four_layers_with_slack_hinges(tmp_path):
+@pytest.mark.parametrize("contact", ["off", "on"])
+def test_pehrsons_vertex_folds_flat_in_four_layers_with_slack_hinges(tmp_path, contact):
     from solids import folded_frame, hull, panel_overlaps, panel_points
 
+    if contact == "on":
+        pytest.importorskip("ipctk")
     path, targets = pehrson_flat_file(tmp_path, "slack")
-    fold = simulate(path)
+    fold = simulate(path, "--contact", contact)
     angles = np.array(fold["edges_foldAngle"][:4])  # the achieved angles
     assert np.abs(angles - targets).max() < 0.01
     frame = folded_frame(fold)

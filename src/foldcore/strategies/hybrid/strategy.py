@@ -184,8 +184,10 @@ class Hybrid(Strategy):
         o = self.options
         if coarse and not done and self._rigid_steps < o.rigid_max_steps:
             return False  # the twin's steps: it hands over itself when it stalls
-        # with contact a step cut short by CCD is tiny without the phase being over
-        tiny = self.rigid.engine.stalls(moved, o.rigid_tol) and self.model.contact is None
+        # a step contact cut short is tiny without the phase being over, unless the
+        # rigid model is not the mesh's (slack hinges): newton must finish anyway
+        tiny = self.rigid.engine.stalls(moved, o.rigid_tol) and (
+            self._slack or not self.rigid.engine.lm.cut)
         if done and self._slack:  # the rigid model's equilibrium, not the mesh's
             done = False
         if done or tiny or self._rigid_steps >= o.rigid_max_steps:

@@ -77,6 +77,7 @@ class LevenbergMarquardt:
         self.slow_ratio = 0.0
         self.accepted_move = None  # mm, the run's last accepted step, if the last step
         self.solve_time = 0.0
+        self.cut = False  # the last step was shortened toward a contact
         self.factor = None  # of JᵀJ + λD, from the first step on a layout
         self._pattern = None  # the layout's pattern version the factor was analysed for
 
@@ -175,10 +176,12 @@ class LevenbergMarquardt:
         checked again."""
         engine = self.engine
         trial = engine.kinematics.apply(start, velocity, engine.lo, engine.hi)
+        self.cut = False  # whether contact shortened this step
         for _ in range(MAX_CUTS):
             fraction = self.crosses(start, trial)
             if fraction is None:
                 return trial, velocity
+            self.cut = True
             velocity = velocity * fraction
             trial = engine.kinematics.apply(start, velocity, engine.lo, engine.hi)
         return engine.kinematics.apply(start, 0.0 * velocity, engine.lo, engine.hi), 0.0 * velocity
