@@ -177,19 +177,21 @@ class ContactModel:
             pairs = pairs[self.solids.gap_bounds(x, pairs) < margin]
         return pairs
 
-    def _joined_near(self, shrunk: np.ndarray, margin: np.ndarray | float) -> np.ndarray:
-        """(K, 2) joined pairs folded past ``JOINED_FROM_DEG`` (their normals' dihedral)
-        whose shrunk panels are not proved ``margin`` apart."""
+    def _joined_near(self, x: np.ndarray, margin: float):
+        """((K, 2) joined pairs folded past ``JOINED_FROM_DEG`` (their normals'
+        dihedral) whose shrunk panels are not proved ``margin`` apart, the shrunk
+        positions or None where no joined pair is folded that far)."""
         s = self.solids
         pairs = s.joined_pairs
         if not len(pairs):
-            return pairs
-        normal, _ = s.normals(shrunk)
+            return pairs, None
+        normal, _ = s.normals(x)  # scaling about the centroid keeps the normals
         folded = np.einsum("ij,ij->i", normal[pairs[:, 0]], normal[pairs[:, 1]]) < JOINED_FROM
         pairs, edges = pairs[folded], s.joined_edge[folded]
         if not len(pairs):
-            return pairs
-        return pairs[s.gap_bounds(shrunk, pairs, edges) < margin]
+            return pairs, None
+        shrunk = s.shrunk(x, JOINED_SHARE)
+        return pairs[s.gap_bounds(shrunk, pairs, edges) < margin], shrunk
 
     def _pairs(self, x: np.ndarray, joined: bool):
         """[(joined, pairs, positions)] to evaluate at x: unjoined pairs within d̂ on
@@ -197,8 +199,8 @@ class ContactModel:
         the shrunk panels."""
         out = [(False, self.candidates(x, self.dhat), x)]
         if joined:
-            shrunk = self.solids.shrunk(x, JOINED_SHARE)
-            out.append((True, self._joined_near(shrunk, self.dhat_joined), shrunk))
+            pairs, shrunk = self._joined_near(x, self.dhat_joined)
+            out.append((True, pairs, shrunk))
         return out
 
     def _pair_mesh(self, a: int, b: int, joined: bool):
@@ -325,8 +327,8 @@ class ContactModel:
             fraction = min(fraction, self.obstacles.free_fraction(x0, x1))
         if not joined:
             return fraction
-        shrunk = s.shrunk(x1, JOINED_SHARE)
-        for a, b in self._joined_near(shrunk, 0.0):
+        pairs, shrunk = self._joined_near(x1, 0.0)
+        for a, b in pairs:
             mesh, ids, _ = self._pair_mesh(int(a), int(b), True)
             if ipctk.has_intersections(mesh, np.asfortranarray(shrunk[ids])):
                 self.blocking.append((int(a), int(b)))
