@@ -146,7 +146,7 @@ def test_a_thick_miura_driven_flat_stops_where_its_panels_meet_and_says_so():
     its panels meet before that (joined panels past 150° whose faces would cross),
     and the report names the creases contact stopped. Without contact the same
     run ends with two panels through each other by more than 1 % of a panel."""
-    from foldcore.outputs import actuation_entries
+    from foldcore.outputs import actuation_entries, run_summary
 
     pattern = patterns.miura(3, 3, a=20.0, b=20.0, gamma=60.0)
     pattern = pattern.replace(fold_angles=patterns.miura_fold_angles(3, 3, 60.0, 90.0))
@@ -155,6 +155,8 @@ def test_a_thick_miura_driven_flat_stops_where_its_panels_meet_and_says_so():
     assert max(overlap_shares(mesh, free.positions).values()) > 0.01
     entries = actuation_entries(held, pattern)
     assert entries["contact_blocked"] and held.contact["blocking_pairs"]
+    _, warnings = run_summary(held, pattern, "miura", 100.0)  # no pair within d̂: no gap
+    assert any("contact stops" in w for w in warnings)
     source = mesh.groups[mesh.panel_group].source
     joined = {tuple(sorted(int(source[p]) for p in pair))
               for pair in PanelSolids(mesh, pattern).joined_pairs}

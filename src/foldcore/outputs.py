@@ -119,10 +119,12 @@ def run_summary(result, pattern, source: str, fold_percent: float,
     if entries["contact_blocked"]:
         blocked = entries["contact_blocked"]
         gap = result.contact["smallest_gap_mm"]
+        near = (f"smallest gap {gap:.3g} mm" if gap is not None else
+                "the next step would make two of them cross")
         warns.append(f"{source}: contact stops {len(blocked)} of {driven} driven creases short "
                      f"of their targets (edges {', '.join(map(str, blocked[:10]))}"
                      + (", …" if len(blocked) > 10 else "") + "): their panels touch "
-                     f"others (smallest gap {gap:.3g} mm); the report's contact section "
+                     f"others ({near}); the report's contact section "
                      "lists the touching panels and their forces")
     if driven and entries["binding"]:
         missed, wrong = entries["missed"] - len(entries["contact_blocked"]), entries["wrong_side"]
