@@ -10,26 +10,25 @@
   interleaved, median of RUNS after a warm-up, and whether the positions are
   bit-identical.
 
-The 1-minute load average is recorded before and after. Run:
-``python bench/contact.py`` (~1 min); writes bench/results/contact.json and
-.png; ``--table`` prints the tables of docs/benchmarks.md from the JSON.
+Run: ``python bench/contact.py`` (about 4 min; ``--quick``: sizes 6 and 10,
+one run); writes bench/results/contact.json and .png with the machine and its
+load (``bench/_meta.py``); ``--table`` prints the tables of docs/benchmarks.md
+from the JSON.
 """
 from __future__ import annotations
 
-import json
-import os
-import platform
 import sys
-import time
 from itertools import combinations
 from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "src"))
-OUT = ROOT / "bench" / "results" / "contact.json"
-SIZES = (10, 20, 30)
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import _meta  # noqa: E402
+
+NAME = "contact"
+SIZES = (10, 20, 30, 40, 50)
+QUICK_SIZES = (6, 10)
 RUNS = 3
 H = 1.0
 
@@ -64,36 +63,33 @@ def letter() -> dict:
     for contact in (False, True):
         sim = Simulation(mesh, pattern, solver="rigid", contact=contact)
         sim.set_fold_angles({0: 180.0, 1: 180.0})
-        t0 = time.perf_counter()
-        result = sim.run(tolerance=1e-8, max_iterations=2_000)
+        seconds, result = _meta.timed(lambda: sim.run(tolerance=1e-8, max_iterations=2_000))
         out["on" if contact else "off"] = {
             "fold_angles_deg": [round(float(a), 4) for a in result.fold_angles_deg[:2]],
             "iterations": int(result.iterations), "reason": result.reason,
-            "seconds": time.perf_counter() - t0,
-            "worst_overlap_share": worst_overlap(mesh, result.positions)}
+            "seconds": seconds, "worst_overlap_share": worst_overlap(mesh, result.positions)}
     return out
 
 
-def overhead() -> list:
+def overhead(sizes, runs: int) -> list:
     from foldcore import patterns
     from foldcore.simulation import Simulation
     from foldcore.strategies.rigid import RigidOptions
     from foldcore.thickening import thicken
 
     rows = []
-    for n in SIZES:
+    for n in sizes:
         pattern = patterns.miura_one_crease(n, n, tilt=45.0)
         mesh = thicken(pattern, H)
-        times, last = {False: [], True: []}, {}
-        for run in range(RUNS + 1):  # the first round warms up
-            for contact in (False, True):
-                sim = Simulation(mesh, pattern, solver="rigid", contact=contact,
-                                 options=RigidOptions(coarse_start=False))
-                t0 = time.perf_counter()
-                last[contact] = sim.run(tolerance=1e-8, max_iterations=2_000)
-                if run:
-                    times[contact].append(time.perf_counter() - t0)
-        off, on = (float(np.median(times[c])) for c in (False, True))
+
+        def fold(contact):
+            sim = Simulation(mesh, pattern, solver="rigid", contact=contact,
+                             options=RigidOptions(coarse_start=False))
+            return _meta.timed(lambda: sim.run(tolerance=1e-8, max_iterations=2_000))
+
+        done = _meta.interleaved({c: (lambda c=c: fold(c)) for c in (False, True)}, runs)
+        off, on = (_meta.median([t for t, _ in done[c]]) for c in (False, True))
+        last = {c: done[c][-1][1] for c in (False, True)}
         rows.append({"n": n, "iterations": int(last[False].iterations),
                      "off_s": off, "on_s": on, "ratio": on / off,
                      "identical": bool(np.array_equal(last[False].positions,
@@ -103,26 +99,22 @@ def overhead() -> list:
 
 
 def table(data: dict) -> str:
-    lines = ["| letter fold | crease 1 | crease 2 | steps | s | worst overlap |",
-             "|---|---|---|---|---|---|"]
+    letter_rows = []
     for key, row in data["letter"].items():
         a, b = row["fold_angles_deg"]
-        lines.append(f"| contact {key} | {a:.4g}° | {b:.4g}° | {row['iterations']} | "
-                     f"{row['seconds']:.2f} | {row['worst_overlap_share']:.2g} |")
-    lines += ["", "| Miura n × n | steps | off (s) | on (s) | on / off | identical |",
-              "|---|---|---|---|---|---|"]
-    for row in data["overhead"]:
-        lines.append(f"| {row['n']} | {row['iterations']} | {row['off_s']:.3g} | "
-                     f"{row['on_s']:.3g} | {row['ratio']:.2f} | {row['identical']} |")
-    return "\n".join(lines)
+        letter_rows.append([f"contact {key}", f"{a:.4g}°", f"{b:.4g}°", row["iterations"],
+                            f"{row['seconds']:.2f}", _meta.sig(row["worst_overlap_share"], 2)])
+    miura_rows = [[row["n"], row["iterations"], _meta.sig(row["off_s"]), _meta.sig(row["on_s"]),
+                   f"{row['ratio']:.2f}", row["identical"]] for row in data["overhead"]]
+    return "\n\n".join([
+        _meta.markdown_table(["letter fold", "crease 1", "crease 2", "steps", "s",
+                              "worst overlap"], letter_rows),
+        _meta.markdown_table(["Miura n × n", "steps", "off (s)", "on (s)", "on / off",
+                              "identical"], miura_rows)])
 
 
-def plot(data: dict) -> None:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
+def plot(data: dict, path: Path) -> None:
+    plt = _meta.pyplot()
     rows = data["overhead"]
     fig, ax = plt.subplots(figsize=(5, 3.5))
     n = [r["n"] for r in rows]
@@ -133,19 +125,17 @@ def plot(data: dict) -> None:
     ax.set_yscale("log")
     ax.legend()
     fig.tight_layout()
-    fig.savefig(OUT.with_suffix(".png"), dpi=120)
+    fig.savefig(path, dpi=120)
 
 
 def main() -> None:
-    if "--table" in sys.argv:
-        print(table(json.loads(OUT.read_text())))
+    args = _meta.parser(__doc__).parse_args()
+    if _meta.stored(NAME, args, table=table, plot=plot):
         return
-    load_before = os.getloadavg()[0]
-    data = {"letter": letter(), "overhead": overhead(),
-            "machine": {"python": platform.python_version(), "cpus": os.cpu_count(),
-                        "load_before": load_before, "load_after": os.getloadavg()[0]}}
-    OUT.write_text(json.dumps(data, indent=1) + "\n")
-    plot(data)
+    sizes, runs = (QUICK_SIZES, 1) if args.quick else (SIZES, RUNS)
+    record = _meta.Record(NAME, args, thickness_mm=H, sizes=list(sizes), runs=runs)
+    data = {"letter": letter(), "overhead": overhead(sizes, runs)}
+    record.write(data, plot)
     print(table(data))
 
 
