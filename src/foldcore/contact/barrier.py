@@ -291,7 +291,7 @@ class ContactModel:
                                                      np.concatenate(cols))), shape=(n, n))
 
     # ------------------------------------------------------------- steps
-    def free_fraction(self, x0: np.ndarray, x1: np.ndarray, joined=True) -> float:
+    def free_fraction(self, x0: np.ndarray, x1: np.ndarray, joined: bool = True) -> float:
         """A share t ∈ [0, 1] of the step x0 → x1 that brings no two panels into
         contact; 1 where nothing comes near. x0 must be intersection-free.
 
@@ -302,10 +302,8 @@ class ContactModel:
         hinge keeps their faces a hair apart; their shrunk geometry is checked
         at x1 instead (½ where it intersects): two panels a hinge joins cannot
         pass through each other without intersecting on the way, and a step is
-        a small turn of that hinge. ``joined`` False leaves them out; ``"new"``
-        cuts only a step that makes them meet (a strategy whose panels are not
-        exactly rigid may hold two of them a hair into each other, which must
-        not stop every step after)."""
+        a small turn of that hinge. ``joined`` False leaves them out (a strategy
+        whose panels are not exactly rigid: their hinge holds them)."""
         s = self.solids
         self.blocking = []
         if not s.n_panels:
@@ -330,17 +328,11 @@ class ContactModel:
         if not joined:
             return fraction
         pairs, shrunk = self._joined_near(x1, 0.0)
-        before = None
         for a, b in pairs:
             mesh, ids, _ = self._pair_mesh(int(a), int(b), True)
-            if not ipctk.has_intersections(mesh, np.asfortranarray(shrunk[ids])):
-                continue
-            if joined == "new":  # only a step that makes them meet is cut
-                before = s.shrunk(x0, JOINED_SHARE) if before is None else before
-                if ipctk.has_intersections(mesh, np.asfortranarray(before[ids])):
-                    continue
-            self.blocking.append((int(a), int(b)))
-            return min(fraction, 0.5)
+            if ipctk.has_intersections(mesh, np.asfortranarray(shrunk[ids])):
+                self.blocking.append((int(a), int(b)))
+                return min(fraction, 0.5)
         return fraction
 
     def overlapping(self, x: np.ndarray) -> np.ndarray:

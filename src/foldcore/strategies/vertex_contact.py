@@ -35,10 +35,9 @@ class VertexContact:
         return self.contact.obstacles is not None
 
     def state(self, x: np.ndarray, adapt: bool = True):
-        """The contacts at x of panels no crease joins (no barrier between panels a
-        crease joins: these panels are not exactly rigid, and at a pivot their faces
-        meet within what the barrier's margin allows; :meth:`collision_free` keeps
-        them from starting to cross), κ first adapted to them
+        """The contacts at x of panels no crease joins (panels a crease joins are its
+        hinge's to hold: these panels are not exactly rigid, and at a pivot their
+        faces meet within what a rigid check allows), κ first adapted to them
         (``ContactModel.stiffen``) where ``adapt``."""
         state = self.contact.state(x, joined=False)
         if adapt and self.contact.stiffen(state):
@@ -76,7 +75,7 @@ class VertexContact:
         two panels (or a panel and an obstacle) into contact; x where that takes more
         than ``MAX_CUTS`` shortenings."""
         for _ in range(MAX_CUTS):
-            fraction = self.contact.free_fraction(x, trial, joined="new")
+            fraction = self.contact.free_fraction(x, trial, joined=False)
             if fraction >= 1.0:
                 return trial
             trial = x + fraction * (trial - x)
