@@ -37,6 +37,10 @@ longer, so the distance left (the geometric tail of the steps) is within the
 limit too — or, on a compatible fold, E down to tolerance² of the run's
 largest, where the steps are rounding.
 
+With contact (``model.contact``) the barrier joins E, its gradient and
+PSD-projected blocks join the step, and every trial is moved back until its
+straight-line motion is collision-free (:mod:`.vertex_contact`).
+
 Cost per step: one assembly of H into a fixed pattern (:class:`HessianPattern`)
 and one sparse Cholesky per trial (CHOLMOD refactors in place, else SciPy),
 plus 1 + ``corrections`` local steps and K solves per trial (the accepted
