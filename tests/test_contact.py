@@ -164,6 +164,23 @@ def test_a_thick_miura_driven_flat_stops_where_its_panels_meet_and_says_so():
     assert not unjoined or max(unjoined.values()) <= OVERLAP_SHARE, unjoined
 
 
+def test_the_chain_scene_with_contact_keeps_unjoined_panels_apart():
+    """``scenes.run(..., contact=True)`` (``foldcore scene NAME --contact on``): the
+    chain pushed across its end stops where its panels meet; no two panels no crease
+    joins overlap (their barrier holds them), and the scene records the setting."""
+    from foldcore import scenes
+
+    run = scenes.run("chain", quick=True, contact=True)
+    assert run.settings["contact"] is True and run.result.contact is not None
+    mesh = run.mesh
+    source = mesh.groups[mesh.panel_group].source
+    joined = {tuple(sorted(int(source[p]) for p in pair))
+              for pair in PanelSolids(mesh, run.pattern).joined_pairs}
+    shares = overlap_shares(mesh, run.result.positions)
+    unjoined = {k: v for k, v in shares.items() if k not in joined}
+    assert not unjoined or max(unjoined.values()) <= OVERLAP_SHARE, unjoined
+
+
 def test_a_step_through_a_panel_is_cut_short_of_it(letter_runs):
     mesh, sim, result = letter_runs[True]
     contact = sim.model.contact

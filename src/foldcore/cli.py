@@ -291,6 +291,9 @@ def _add_scene(sub) -> None:
                      help="iteration strategy (default: the scene's own, see its docstring)")
     scn.add_argument("--quick", action="store_true",
                      help="lower iteration budgets (tests); same geometry")
+    scn.add_argument("--contact", choices=CONTACT_CHOICES, default="off",
+                     help="on: panels never pass through each other (scenes of rigid "
+                          "panels); default off")
 
 
 def run_scene(args) -> int:
@@ -302,7 +305,8 @@ def run_scene(args) -> int:
 
     if not Path(args.out).is_dir():
         raise FoldcoreError(f"{args.out}: output folder does not exist")
-    run = scenes.run(args.name, quick=args.quick, solver=args.solver)
+    run = scenes.run(args.name, quick=args.quick, solver=args.solver,
+                     contact=args.contact == "on")
     for path in scenes.write(run, args.out, png=args.render):
         print(path)
     if not run.result.converged:

@@ -50,8 +50,8 @@ class Obstacle:
         if v.ndim != 2 or v.shape[1] != 3 or not len(v):
             raise ObstacleError(f"{self.name}: vertices must be (M, 3), got shape {v.shape}")
         if not np.isfinite(v).all():
-            raise ObstacleError(f"{self.name}: vertex {int(np.flatnonzero(~np.isfinite(v).all(1))[0])}"
-                                " is not finite")
+            bad_vertex = int(np.flatnonzero(~np.isfinite(v).all(axis=1))[0])
+            raise ObstacleError(f"{self.name}: vertex {bad_vertex} is not finite")
         if f.ndim != 2 or f.shape[1] != 3 or not len(f) or not np.issubdtype(f.dtype, np.integer):
             raise ObstacleError(f"{self.name}: faces must be (F, 3) integers, got {f.dtype} "
                                 f"{f.shape}")

@@ -63,7 +63,8 @@ class SceneRun:
     gallery: list = field(default_factory=list)
 
 
-def run(name: str, quick: bool = False, solver: str | None = None) -> SceneRun:
+def run(name: str, quick: bool = False, solver: str | None = None,
+        contact: bool = False) -> SceneRun:
     """Run scene ``name`` (see ``NAMES``).
 
     Parameters
@@ -72,8 +73,11 @@ def run(name: str, quick: bool = False, solver: str | None = None) -> SceneRun:
         Lower iteration budgets (tests); the geometry is unchanged.
     solver : str, optional
         Strategy (``foldcore.strategies.SOLVERS``); default: the scene's own.
+    contact : bool
+        Keep panels from passing through each other (:mod:`foldcore.contact`;
+        scenes of rigid panels, strategies that take it).
     """
-    return _module(name).run(quick=quick, solver=solver)
+    return _module(name).run(quick=quick, solver=solver, contact=contact)
 
 
 def headline(name: str, quantities: dict) -> str:

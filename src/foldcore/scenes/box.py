@@ -101,17 +101,19 @@ APEX = np.radians(30.0)  # gusset triangle angle at the bottom corner
 THIN_BOX_MM3 = 1.5 * np.sqrt(3.0) * SIDE ** 2 * HEIGHT
 
 
-def run(quick: bool = False, solver: str | None = None) -> SceneRun:
+def run(quick: bool = False, solver: str | None = None,
+        contact: bool = False) -> SceneRun:
     """Fold the tray at H = 1 mm and 4 mm (see module docstring); the result is 4 mm."""
     solver = solver or "rigid"
     budget = (100 if quick else 400) if solver == "rigid" else (5_000 if quick else 40_000)
     rows = []
     for thickness in THICKNESSES:
         start = time.perf_counter()
-        pattern, mesh, result = fold(thickness, solver, budget)
+        pattern, mesh, result = fold(thickness, solver, budget, contact)
         rows.append(measure(pattern, mesh, result, thickness, time.perf_counter() - start))
     quantities = {"thin_box_mm3": round(float(THIN_BOX_MM3), 2), "runs": rows}
-    settings = {"solver": solver, "tolerance": TOLERANCE, "max_iterations": budget,
+    settings = {"solver": solver, "contact": contact, "tolerance": TOLERANCE,
+                "max_iterations": budget,
                 "thicknesses_mm": list(THICKNESSES), "side_mm": SIDE, "height_mm": HEIGHT,
                 "subdivisions": SUBDIVISIONS, "shown_thickness_mm": THICKNESSES[-1]}
     return SceneRun("box", pattern, mesh, THICKNESSES[-1], result, quantities, settings)
@@ -126,8 +128,9 @@ def headline(quantities: dict) -> str:
         " of the thin tray" for r in quantities["runs"])
 
 
-def fold(thickness: float, solver: str, budget: int):
-    """Build, thicken and fold the tray at one thickness H (mm).
+def fold(thickness: float, solver: str, budget: int, contact: bool = False):
+    """Build, thicken and fold the tray at one thickness H (mm) (``contact``: panels
+    kept from passing through each other).
 
     Returns
     -------
@@ -139,8 +142,8 @@ def fold(thickness: float, solver: str, budget: int):
     width = float(minimum_hinge_width(thickness, SIZING_ANGLE))
     pattern = hexagonal_tray(SIDE, HEIGHT, width)
     mesh = thicken(pattern, thickness, subdivisions=SUBDIVISIONS)
-    result = Simulation(mesh, pattern, solver=solver).run(tolerance=TOLERANCE,
-                                                         max_iterations=budget)
+    result = Simulation(mesh, pattern, solver=solver, contact=contact).run(
+        tolerance=TOLERANCE, max_iterations=budget)
     return pattern, mesh, result
 
 

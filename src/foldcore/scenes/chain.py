@@ -71,13 +71,14 @@ TOLERANCE = 1e-10
 HINGE = "arc"  # the paper's strained joint; why not the default axis hinge: module docstring
 
 
-def run(quick: bool = False, solver: str | None = None) -> SceneRun:
+def run(quick: bool = False, solver: str | None = None,
+        contact: bool = False) -> SceneRun:
     """Deploy the chain, then push one end across it (see module docstring)."""
     solver = solver or "rigid"
     budget = 400 if solver == "rigid" else (5_000 if quick else 40_000)
     pattern, expected = _deployed_pattern()
     mesh = thicken(pattern, THICKNESS, subdivisions=SUBDIVISIONS, hinge=HINGE)
-    sim = Simulation(mesh, pattern, solver=solver)
+    sim = Simulation(mesh, pattern, solver=solver, contact=contact)
     deployed = sim.run(tolerance=TOLERANCE, max_iterations=budget)
     sim.set_fold_angles({int(e): None for e in pattern.creases})
     held, pushed = _panel_vertices(mesh, 0), _corner_vertices(pattern, mesh)
@@ -96,7 +97,8 @@ def run(quick: bool = False, solver: str | None = None) -> SceneRun:
     quantities = {"deployed": _deployed_quantities(deployed, pattern, expected, kinds),
                   "before": _lengths(rows[0]), "after": _lengths(rows[-1]),
                   "rigid_fold_lengths_mm": _rigid_fold_lengths(), "pushes": rows}
-    settings = {"solver": solver, "tolerance": TOLERANCE, "max_iterations": budget,
+    settings = {"solver": solver, "contact": contact, "tolerance": TOLERANCE,
+                "max_iterations": budget,
                 "thickness_mm": THICKNESS, "hinge_width_mm": round(WIDTH, 4),
                 "subdivisions": SUBDIVISIONS, "n": N, "m": M, "a_mm": A, "b_mm": B,
                 "gamma_deg": GAMMA, "tilt_deg": TILT, "push_alpha": PUSH_ALPHA}

@@ -53,12 +53,13 @@ INTERMEDIATE = 90.0  # crease 1 target, degrees
 TOLERANCE = 1e-10  # relative step at which a state counts as reached
 
 
-def run(quick: bool = False, solver: str | None = None) -> SceneRun:
+def run(quick: bool = False, solver: str | None = None,
+        contact: bool = False) -> SceneRun:
     """Fold the vertex to its intermediate and flat states (see module docstring)."""
     budget = 400 if quick else 2_000
     pattern = degree4_vertex(mode="A", rho1=INTERMEDIATE)
     mesh = thicken(pattern, THICKNESS, subdivisions=SUBDIVISIONS, hinge=HINGE)
-    sim = Simulation(mesh, pattern, **({"solver": solver} if solver else {}))
+    sim = Simulation(mesh, pattern, contact=contact, **({"solver": solver} if solver else {}))
     sign = np.where(pattern.assignments[:4] == "M", -1.0, 1.0)
     targets = {"intermediate": {0: INTERMEDIATE},
                "flat": {i: 180.0 * sign[i] for i in range(4)}}
@@ -77,7 +78,7 @@ def run(quick: bool = False, solver: str | None = None) -> SceneRun:
                 degree4_deg(alpha, beta, min(abs(angles[0]), 180.0), "A")),
             "iterations": int(result.iterations - before), "converged": bool(result.converged)}
     quantities["flat"].update(stack(mesh, pattern, result.positions))
-    settings = {"solver": sim.solver, "hinge": HINGE, "tolerance": TOLERANCE,
+    settings = {"solver": sim.solver, "contact": contact, "hinge": HINGE, "tolerance": TOLERANCE,
                 "max_iterations": budget, "thickness_mm": THICKNESS,
                 "subdivisions": SUBDIVISIONS}
     return SceneRun("d4v", sim.pattern, mesh, THICKNESS, result, quantities, settings)

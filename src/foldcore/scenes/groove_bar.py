@@ -58,7 +58,8 @@ def hinge_pose(points: np.ndarray, psi_deg: float, model: str = DEFAULT_HINGE) -
     return np.column_stack([xz[:, 0], points[:, 1], xz[:, 1]])
 
 
-def run(quick: bool = False, solver: str | None = None) -> SceneRun:
+def run(quick: bool = False, solver: str | None = None,
+        contact: bool = False) -> SceneRun:
     """Pull the bar past its groove's limit (see module docstring)."""
     solver = solver or "lbfgs"
     budget = 10_000 if quick else 40_000
@@ -68,7 +69,7 @@ def run(quick: bool = False, solver: str | None = None) -> SceneRun:
     rest = mesh.rest_positions
     held = np.flatnonzero(np.isclose(rest[:, 0], -PANEL))
     pulled = np.flatnonzero(np.isclose(rest[:, 0], PANEL))
-    sim = Simulation(mesh, pattern, solver=solver)
+    sim = Simulation(mesh, pattern, solver=solver, contact=contact)
     sim.add_position_target(held, name="held")
     sim.add_position_target(pulled, name="pull")
     panels, hinges = mesh.groups[mesh.panel_group], mesh.groups["bending_hinge"]
@@ -89,7 +90,8 @@ def run(quick: bool = False, solver: str | None = None) -> SceneRun:
                      "iterations": int(result.iterations) - done,
                      "converged": bool(result.converged)})
         done = int(result.iterations)
-    settings = {"solver": solver, "tolerance": TOLERANCE, "max_iterations": budget,
+    settings = {"solver": solver, "contact": contact, "tolerance": TOLERANCE,
+                "max_iterations": budget,
                 "thickness_mm": THICKNESS, "hinge_width_mm": WIDTH, "cells": CELLS}
     return SceneRun("groove-bar", pattern, mesh, THICKNESS, result, {"steps": rows}, settings)
 

@@ -42,7 +42,8 @@ TOLERANCE = 1e-11
 DEGENERATE_RADIUS = 100.0  # fitted radius / span of the inner points beyond which: no circle
 
 
-def run(quick: bool = False, solver: str | None = None) -> SceneRun:
+def run(quick: bool = False, solver: str | None = None,
+        contact: bool = False) -> SceneRun:
     """Fold the hinge for every (hinge model, W, k) (module docstring); the last is the result."""
     solver = solver or "rigid"
     budget = (100 if quick else 400) if solver == "rigid" else (5_000 if quick else 60_000)
@@ -50,7 +51,7 @@ def run(quick: bool = False, solver: str | None = None) -> SceneRun:
     for model, width, k in itertools.product(MODELS, WIDTHS, SUBDIVISIONS):
         pattern = single_hinge(panel_length=PANEL, depth=DEPTH, angle=ANGLE, width=width)
         mesh = thicken(pattern, THICKNESS, subdivisions=k, hinge=model)
-        result = Simulation(mesh, pattern, solver=solver).run(tolerance=TOLERANCE,
+        result = Simulation(mesh, pattern, solver=solver, contact=contact).run(tolerance=TOLERANCE,
                                                              max_iterations=budget)
         achieved = float(result.fold_angles_deg[0])
         rows.append({
@@ -64,7 +65,8 @@ def run(quick: bool = False, solver: str | None = None) -> SceneRun:
             "iterations": int(result.iterations), "converged": bool(result.converged)})
         gallery.append((f"{model} W {width:g} k {k}: {achieved:.2f}°", pattern, mesh,
                         result.positions))
-    settings = {"solver": solver, "tolerance": TOLERANCE, "max_iterations": budget,
+    settings = {"solver": solver, "contact": contact, "tolerance": TOLERANCE,
+                "max_iterations": budget,
                 "thickness_mm": THICKNESS, "panel_mm": PANEL, "depth_mm": DEPTH}
     return SceneRun("hinge-study", pattern, mesh, THICKNESS, result, {"runs": rows}, settings,
                     gallery)

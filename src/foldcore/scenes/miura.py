@@ -38,7 +38,8 @@ TILT = 30.0  # facet tilt θ, degrees
 TOLERANCE = 1e-10
 
 
-def run(quick: bool = False, solver: str | None = None) -> SceneRun:
+def run(quick: bool = False, solver: str | None = None,
+        contact: bool = False) -> SceneRun:
     """Fold the sheet to tilt θ with every crease actuated (see module docstring)."""
     solver = solver or "rigid"
     budget = (100 if quick else 400) if solver == "rigid" else (2_000 if quick else 40_000)
@@ -47,7 +48,7 @@ def run(quick: bool = False, solver: str | None = None) -> SceneRun:
     kinds = miura_edge_kinds(N, M)
     zigzag, straight = miura_angles_deg(GAMMA, TILT)
     mesh = thicken(pattern, THICKNESS, subdivisions=SUBDIVISIONS)
-    result = Simulation(mesh, pattern, solver=solver).run(tolerance=TOLERANCE,
+    result = Simulation(mesh, pattern, solver=solver, contact=contact).run(tolerance=TOLERANCE,
                                                          max_iterations=budget)
     quantities = {"tilt_deg": TILT, "iterations": int(result.iterations),
                   "converged": bool(result.converged)}
@@ -58,7 +59,8 @@ def run(quick: bool = False, solver: str | None = None) -> SceneRun:
                               "achieved_mean_deg": round(float(achieved.mean()), 4),
                               "max_deviation_deg": round(float(np.abs(achieved - closed).max()), 4)}
     quantities["extent_mm"] = _extents(pattern, mesh, result.positions)
-    settings = {"solver": solver, "tolerance": TOLERANCE, "max_iterations": budget,
+    settings = {"solver": solver, "contact": contact, "tolerance": TOLERANCE,
+                "max_iterations": budget,
                 "thickness_mm": THICKNESS, "hinge_width_mm": WIDTH,
                 "subdivisions": SUBDIVISIONS, "n": N, "m": M, "a_mm": A, "b_mm": B,
                 "gamma_deg": GAMMA}

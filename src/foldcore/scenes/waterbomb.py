@@ -36,7 +36,8 @@ TABLE_1 = {"position_1": {"prototype": (-82.0, 32.0), "paper_simulation": (-82.0
 TOLERANCE = 1e-10
 
 
-def run(quick: bool = False, solver: str | None = None) -> SceneRun:
+def run(quick: bool = False, solver: str | None = None,
+        contact: bool = False) -> SceneRun:
     """Fold position 1 and position 2 from the flat sheet (see module docstring)."""
     solver = solver or "rigid"
     budget = (100 if quick else 400) if solver == "rigid" else (2_000 if quick else 40_000)
@@ -47,7 +48,7 @@ def run(quick: bool = False, solver: str | None = None) -> SceneRun:
         pattern = waterbomb(N_CREASES, radius=RADIUS, major=major, width=WIDTH,
                             major_angle=abs(major_angle))
         mesh = thicken(pattern, THICKNESS, subdivisions=SUBDIVISIONS)
-        result = Simulation(mesh, pattern, solver=solver).run(tolerance=TOLERANCE,
+        result = Simulation(mesh, pattern, solver=solver, contact=contact).run(tolerance=TOLERANCE,
                                                              max_iterations=budget)
         angles = result.fold_angles_deg[:N_CREASES]
         kinds = pattern.assignments[:N_CREASES]
@@ -60,7 +61,8 @@ def run(quick: bool = False, solver: str | None = None) -> SceneRun:
                                                                      abs(major_angle))), 3),
             "table_1": TABLE_1[position],
             "iterations": int(result.iterations), "converged": bool(result.converged)}
-    settings = {"solver": solver, "tolerance": TOLERANCE, "max_iterations": budget,
+    settings = {"solver": solver, "contact": contact, "tolerance": TOLERANCE,
+                "max_iterations": budget,
                 "thickness_mm": THICKNESS, "hinge_width_mm": WIDTH,
                 "subdivisions": SUBDIVISIONS, "radius_mm": RADIUS}
     return SceneRun("waterbomb", pattern, mesh, THICKNESS, result, quantities, settings)

@@ -160,7 +160,8 @@ class Newton(Strategy):
                     trial_energy, trial_rhs = np.inf, None
             if trial is not x:
                 trial_energy, trial_rhs = model.local_step(trial)
-            trial_touch = None if self.contact is None else self.contact.state(trial, adapt=False)
+            trial_touch = (None if self.contact is None
+                           else self.contact.state(trial, adapt=False))
             if trial_touch is not None:
                 trial_energy += trial_touch.energy
             if trial_energy <= energy + noise:
