@@ -156,14 +156,13 @@ class Newton(Strategy):
             trial = self._corrected(x + delta)
             if self.contact is not None:
                 trial = self.contact.collision_free(x, trial)
-                if trial is x:  # no share of the step is free: a shorter one may be
-                    trial_energy, trial_rhs = np.inf, None
-            if trial is not x:
+            if trial is x:  # no share of the step is free of contact: a shorter one may be
+                trial_energy, trial_rhs, trial_touch = np.inf, None, None
+            else:
                 trial_energy, trial_rhs = model.local_step(trial)
-            trial_touch = (None if self.contact is None
-                           else self.contact.state(trial, adapt=False))
-            if trial_touch is not None:
-                trial_energy += trial_touch.energy
+                trial_touch = None if self.contact is None else self.contact.state(trial)
+                if trial_touch is not None:
+                    trial_energy += trial_touch.energy
             if trial_energy <= energy + noise:
                 self.accepted, self.undamped = True, self.lam <= o.lambda_settled
                 self.lam = max(self.lam / o.lambda_down, o.lambda_min)
@@ -187,17 +186,17 @@ class Newton(Strategy):
         accepted ``x`` while K is the same (a stop that closed there refactors it) and
         the barrier's stiffness holds, else projected anew. E includes the barrier's."""
         at, self._at = self._at, None
-        if self.contact is not None:
-            touch = self.contact.state(x)  # κ may stiffen: then E is taken anew
-            if at is not None and at[0] is x and at[4] == self.model.system.version \
-                    and touch.energy == at[5].energy:
-                return at[1], at[2], at[3], touch
-            energy, rhs = self.model.local_step(x)
-            return energy + touch.energy, rhs, self.model.slot_targets, touch
-        if at is not None and at[0] is x and at[4] == self.model.system.version:
-            return at[1], at[2], at[3], None
+        kept = at is not None and at[0] is x and at[4] == self.model.system.version
+        touch = None
+        if self.contact is not None:  # κ may stiffen: then E is taken anew
+            touch = self.contact.adapted(x, at[5] if kept else None)
+            kept = kept and touch is at[5]
+        if kept:
+            return at[1], at[2], at[3], touch
         energy, rhs = self.model.local_step(x)
-        return energy, rhs, self.model.slot_targets, None
+        if touch is not None:
+            energy += touch.energy
+        return energy, rhs, self.model.slot_targets, touch
 
     def settled(self, moved: float, limit: float) -> bool:
         """An accepted step, damped at most ``lambda_settled``, within ``limit`` mm,

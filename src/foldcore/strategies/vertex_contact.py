@@ -34,15 +34,17 @@ class VertexContact:
         """Obstacles hold the sheet in space: its rigid motions cost energy."""
         return self.contact.obstacles is not None
 
-    def state(self, x: np.ndarray, adapt: bool = True):
+    def state(self, x: np.ndarray):
         """The contacts at x of panels no crease joins (panels a crease joins are its
         hinge's to hold: these panels are not exactly rigid, and at a pivot their
-        faces meet within what a rigid check allows), κ first adapted to them
-        (``ContactModel.stiffen``) where ``adapt``."""
-        state = self.contact.state(x, joined=False)
-        if adapt and self.contact.stiffen(state):
-            state = self.contact.state(x, joined=False)
-        return state
+        faces meet within what a rigid check allows)."""
+        return self.contact.state(x, joined=False)
+
+    def adapted(self, x: np.ndarray, state=None):
+        """The contacts at x (``state``, if given, is theirs), κ first adapted to them
+        (``ContactModel.stiffen``): the same ``state`` where κ held, else taken anew."""
+        state = self.state(x) if state is None else state
+        return self.state(x) if self.contact.stiffen(state) else state
 
     def gradient(self, state) -> np.ndarray:
         """(3N,) ½∇C, mm⁴."""
@@ -51,24 +53,19 @@ class VertexContact:
     def blocks(self, state) -> tuple[list, list]:
         """([(n, m) ids per block size], [(n, 3m, 3m) values of ½∇²C]): every block the
         pattern holds (a touching pair's vertices), zero where it does not touch now."""
-        found = {}
-        for ids, block in self.contact.hessian_blocks(state):
-            keys = self._keys.setdefault(len(ids), {})
-            key = tuple(int(i) for i in ids)
+        terms = [(tuple(int(i) for i in ids), block)
+                 for ids, block in self.contact.hessian_blocks(state)]
+        for key, _ in terms:
+            keys = self._keys.setdefault(len(key), {})
             if key not in keys:
                 keys[key] = len(keys)
                 self.version += 1
-            m = len(ids)
-            values = found.setdefault(m, np.zeros((len(keys), 3 * m, 3 * m)))
-            if len(values) < len(keys):
-                values = found[m] = np.concatenate(
-                    [values, np.zeros((len(keys) - len(values), 3 * m, 3 * m))])
-            values[keys[key]] += 0.5 * block.toarray()
-        runs, values = [], []
-        for m, keys in sorted(self._keys.items()):
-            runs.append(np.array(list(keys), dtype=np.int64).reshape(len(keys), m))
-            values.append(found.get(m, np.zeros((len(keys), 3 * m, 3 * m))))
-        return runs, values
+        values = {m: np.zeros((len(keys), 3 * m, 3 * m)) for m, keys in self._keys.items()}
+        for key, block in terms:
+            values[len(key)][self._keys[len(key)][key]] += 0.5 * block.toarray()
+        sizes = sorted(self._keys)
+        return ([np.array(list(self._keys[m]), dtype=np.int64).reshape(-1, m) for m in sizes],
+                [values[m] for m in sizes])
 
     def collision_free(self, x: np.ndarray, trial: np.ndarray) -> np.ndarray:
         """``trial`` moved back toward x until the straight-line motion x → it brings no
