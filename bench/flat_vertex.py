@@ -7,10 +7,12 @@ each hinge model and the strategies that take it (slack under `hybrid` also
 with contact on), tolerance 1e-10:
 
 * accuracy: the largest miss of a crease from 180° (°); the panels' layers
-  (mid-planes along the normal of panel 0 closer than H/2 are one layer), the
+  (mid-planes along the normal of the panel left of crease 1 closer than H/2
+  are one layer), the
   smallest distance between consecutive layers (mm, ≥ H: no two panels
-  interpenetrate) and the stack height (mm); the worst overlap of two panels'
-  convex hulls as a share of the smaller panel (manifold3d, when installed);
+  interpenetrate) and the stack height (mm), as the d4v scene measures them;
+  the worst overlap of two panels' convex hulls as a share of the smaller
+  panel (manifold3d, as ``bench/contact.py`` measures it);
 * cost: iterations and wall seconds (median of RUNS after a warm-up, the
   cases interleaved round by round).
 
@@ -21,13 +23,13 @@ docs/benchmarks.md.
 from __future__ import annotations
 
 import sys
-from itertools import combinations
 from pathlib import Path
 
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import _meta  # noqa: E402
+from contact import worst_overlap  # noqa: E402
 
 NAME = "flat_vertex"
 H = 3.175  # mm
@@ -54,50 +56,29 @@ def fold_flat(hinge: str, solver: str, contact: bool) -> dict:
     return {"seconds": seconds, "iterations": int(result.iterations), "reason": result.reason,
             "fold_angles_deg": [round(float(a), 6) for a in result.fold_angles_deg[:4]],
             "largest_miss_deg": float(np.abs(result.fold_angles_deg[:4] - targets).max()),
-            **stack(mesh, result.positions)}
+            **stack(mesh, pattern, result.positions)}
 
 
-def panels(mesh, positions) -> list:
-    """(k, 3) positions (mm) of each rigid panel's prism."""
-    g = mesh.groups[mesh.panel_group]
-    return [positions[g.indices[g.slots(p)]] for p in range(len(g))]
+def stack(mesh, pattern, positions) -> dict:
+    """Layers, smallest gap between consecutive layers' mid-planes and stack height
+    (mm) as the d4v scene measures them, and the worst hull overlap share (the
+    contact benchmark's)."""
+    from foldcore.scenes.d4v import stack as scene_stack
 
-
-def stack(mesh, positions) -> dict:
-    """Layers, smallest gap between consecutive layers' mid-planes, stack height (mm)
-    and worst hull overlap share of the folded vertex."""
-    points = panels(mesh, positions)
-    first = points[0] - points[0].mean(axis=0)
-    normal = np.linalg.svd(first)[2][2]
-    levels = np.sort([p.mean(axis=0) @ normal for p in points])
-    gaps = np.diff(levels)
-    along = positions @ normal
-    return {"layers": 1 + int(np.sum(gaps > 0.5 * H)), "smallest_gap_mm": float(gaps.min()),
-            "stack_height_mm": float(along.max() - along.min()),
-            "worst_overlap_share": worst_overlap(points)}
-
-
-def worst_overlap(points) -> float | None:
-    """Largest intersection volume of two panels' convex hulls over the smaller one's
-    volume (None without manifold3d)."""
-    try:
-        import manifold3d
-    except ImportError:
-        return None
-    hulls = [manifold3d.Manifold.hull_points(np.ascontiguousarray(p)) for p in points]
-    return max([(a ^ b).volume() / min(a.volume(), b.volume())
-                for a, b in combinations(hulls, 2)] + [0.0])
+    measured = scene_stack(mesh, pattern, positions)
+    return {"layers": measured["layers"], "smallest_gap_mm": measured["smallest_layer_gap_mm"],
+            "stack_height_mm": measured["stack_height_mm"],
+            "worst_overlap_share": worst_overlap(mesh, positions)}
 
 
 def table(data: dict) -> str:
     rows = []
     for row in data["rows"]:
-        overlap = row["worst_overlap_share"]
         rows.append([row["hinge"], row["solver"], "on" if row.get("contact") else "off",
                      _meta.sig(row["largest_miss_deg"], 2),
                      row["layers"], f"{row['smallest_gap_mm']:.3f}",
                      f"{row['stack_height_mm']:.2f}",
-                     "—" if overlap is None else _meta.sig(overlap, 2),
+                     _meta.sig(row["worst_overlap_share"], 2),
                      row["iterations"], f"{row['seconds']:.3f}", row["reason"]])
     return _meta.markdown_table(
         ["hinge", "solver", "contact", "largest miss (°)", "layers", "smallest gap (mm)",
