@@ -27,7 +27,7 @@ from ...errors import SimulationError
 from ..base import Strategy
 from ..lbfgs import Lbfgs, LbfgsOptions
 from ..newton import Newton, NewtonOptions
-from ..rigid import Rigid, RigidOptions, at_rest
+from ..rigid import Rigid, RigidOptions, at_rest, slack_creases
 from .rings import RigidStart, in_rings, rigid_twin_mesh
 
 
@@ -74,7 +74,7 @@ class Hybrid(Strategy):
         self._engine = None  # the rigid phase's strategy, built on the first run (False: none)
         self._start = None  # the rigid phase of a mesh in rings while it runs (RigidStart)
         # slack hinges: the rigid phase holds their strips at their shortest, newton frees them
-        self._slack = bool(np.any(np.asarray(model.mesh.hinge_model) == "slack"))
+        self._slack = bool(len(slack_creases(model.mesh)))
 
     def _finishing(self) -> Strategy:
         """The strategy after (or instead of) the rigid phase: ``newton`` on a mesh whose

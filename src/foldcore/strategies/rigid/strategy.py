@@ -42,12 +42,17 @@ def at_rest(model, x: np.ndarray, tolerance: float) -> bool:
     return not model.position_targets and gap <= tolerance * model.length_scale
 
 
+def slack_creases(mesh) -> np.ndarray:
+    """(K,) crease edges of ``mesh`` with slack hinges (:mod:`foldcore.hinges`)."""
+    return np.flatnonzero(np.asarray(mesh.hinge_model) == "slack")
+
+
 def refuse_slack(mesh) -> None:
     """SimulationError where ``mesh`` has slack hinges: this strategy bends every strip
     along a neutral axis of a length set by its angle, a slack strip's length is
     free between bounds (:mod:`foldcore.hinges`); ``hybrid`` uses these steps as
     its predictor and finishes such meshes with ``newton``."""
-    slack = np.flatnonzero(np.asarray(mesh.hinge_model) == "slack")
+    slack = slack_creases(mesh)
     if len(slack):
         listed = ", ".join(str(int(e)) for e in slack[:8]) + (" …" if len(slack) > 8 else "")
         raise SimulationError(f"solver 'rigid' holds every hinge strip at the length its "
