@@ -201,6 +201,30 @@ def test_a_step_through_a_panel_is_cut_short_of_it(letter_runs):
     assert min(fractions) < 1.0 and max(fractions) == 1.0
 
 
+def test_a_step_through_a_panel_far_from_it_at_both_ends_is_cut_short():
+    """A panel 3 mm above another moved 6 mm down in one step: apart at both ends, so
+    only a bound that holds along the whole motion sends the pair to the continuous
+    check (the broad phase's bound once took the smaller of the two ends' gaps, 2 mm,
+    and let the step through)."""
+    from foldcore.contact import ContactModel
+
+    pattern = patterns.miura_one_crease(3, 3, tilt=45.0)
+    mesh = thicken(pattern, H)
+    contact = ContactModel(mesh, pattern, 1.0)
+    s = contact.solids
+    joined = {tuple(p) for p in s.joined_pairs}
+    a, b = next((a, b) for a in range(s.n_panels) for b in range(a + 1, s.n_panels)
+                if (a, b) not in joined)
+    x0 = mesh.rest_positions.copy()
+    below, above = (s.vertices[s.ptr[p]:s.ptr[p + 1]] for p in (a, b))
+    x0[above] += x0[below].mean(axis=0) - x0[above].mean(axis=0) + [0.0, 0.0, 3 * H]
+    x1 = x0.copy()
+    x1[above] -= [0.0, 0.0, 6 * H]
+    assert len(contact.overlapping(x0)) == 0 and len(contact.overlapping(x1)) == 0
+    t = contact.free_fraction(x0, x1, joined=False)
+    assert t < 0.5 and len(contact.overlapping(x0 + t * (x1 - x0))) == 0
+
+
 def test_joined_panels_keep_their_shrunk_faces_apart():
     assert 0 < JOINED_SHARE <= OVERLAP_SHARE
 

@@ -193,8 +193,11 @@ class PanelSolids:
         panels' convex hulls, which contain the panels.
 
         With ``later`` positions, the bound holds for the whole straight-line
-        motion x → later: along a fixed axis a gap is concave in the motion's
-        parameter, so the smaller of its two end values bounds it."""
+        motion x → later (axes taken at x): along a fixed axis, b's lowest point
+        less a's highest is concave in the motion's parameter, so the smaller of
+        its two end values bounds it, and so for a over b; the larger of those
+        two bounds the gap. (The smaller of the two ends' gaps is not a bound: a
+        panel that passes through the other in one step is apart at both ends.)"""
         if not len(pairs):
             return np.zeros(0)
         normal, centre = self.normals(x)
@@ -210,11 +213,13 @@ class PanelSolids:
             length = np.linalg.norm(axis, axis=1)
             usable = length > 1e-6
             unit = axis / np.where(usable, length, 1.0)[:, None]
-            gap = np.full(len(pairs), np.inf)
+            b_over_a = a_over_b = np.full(len(pairs), np.inf)
             for y in (x,) if later is None else (x, later):
                 lo_a, hi_a = self._interval(y, span_a, unit)
                 lo_b, hi_b = self._interval(y, span_b, unit)
-                gap = np.minimum(gap, np.maximum(lo_b - hi_a, lo_a - hi_b))
+                b_over_a, a_over_b = np.minimum(b_over_a, lo_b - hi_a), np.minimum(a_over_b,
+                                                                                 lo_a - hi_b)
+            gap = np.maximum(b_over_a, a_over_b)
             bound = np.maximum(bound, np.where(usable, gap, -np.inf))
         return bound
 
