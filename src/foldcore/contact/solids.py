@@ -7,11 +7,11 @@ panels are *joined* when a crease's hinge strip connects them; the hinge
 model keeps those apart, and at a flat fold they touch face to face by design,
 so contact leaves them to it. Every other pair is a contact candidate.
 
-The broad phase has two stages, both vectorised: axis-aligned boxes (within a
-margin), then a separating-axis bound: the gap between the two panels'
-vertex intervals along their normals, the bisectors of those and the line
-between their centroids. That bound
-is a lower bound of the true distance, so a pair it proves farther than the
+The broad phase has two stages: axis-aligned boxes (within a margin) from a
+Verlet list, then a separating-axis bound (numba, :mod:`.kernels`): the gap
+between the two panels' vertex intervals along their normals, the bisectors
+of those and the line between their centroids. That bound is a lower bound
+of the true distance, so a pair it proves farther than the
 margin cannot touch. Units: mm.
 """
 from __future__ import annotations
@@ -21,6 +21,7 @@ from scipy.spatial import cKDTree
 
 from ..mesh import prism_face_loops
 from ..surface import triangulate_polygons
+from . import kernels
 
 
 class PanelSolids:
@@ -56,21 +57,9 @@ class PanelSolids:
         self.vertices = np.concatenate(ids).astype(np.int64) if ids else np.zeros(0, np.int64)
         self.ptr = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
         self.panel_of_vertex = np.repeat(np.arange(self.n_panels), sizes)
-        self._init_top_loops(sizes)
         self.triangles = self._triangles(mesh, ids)
         self.joined = self._joined(mesh, pattern)
         self._verlet = None  # (pairs, box centres, half sizes, reach) of pairs_near's list
-
-    def _init_top_loops(self, sizes: np.ndarray) -> None:
-        """Each top-loop vertex and the next one in its loop (indices into
-        :attr:`vertices`) and its panel: Newell's normal, vectorised."""
-        half = sizes // 2
-        first = self.ptr[:-1]
-        self._top = _ranges(first, half)
-        owner = np.repeat(np.arange(self.n_panels), half)
-        position = self._top - first[owner]
-        self._top_next = first[owner] + (position + 1) % half[owner]
-        self._top_owner = owner
 
     def _triangles(self, mesh, ids) -> list:
         """Outward triangles of each prism, local vertex indices."""
@@ -123,20 +112,16 @@ class PanelSolids:
     # ---------------------------------------------------------- geometry
     def boxes(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(lo, hi), each (n_panels, 3): every panel's axis-aligned box at positions x."""
-        points = x[self.vertices]
-        start = self.ptr[:-1]
-        return np.minimum.reduceat(points, start), np.maximum.reduceat(points, start)
+        lo, hi = np.empty((self.n_panels, 3)), np.empty((self.n_panels, 3))
+        kernels.boxes(_positions(x), self.vertices, self.ptr, lo, hi)
+        return lo, hi
 
     def normals(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(normal, mid-plane point), each (n_panels, 3): each panel's unit normal
         (Newell's, of its top loop) and the centroid of its vertices."""
-        points = x[self.vertices]
-        centre = self._centres(points)
-        cross = np.cross(points[self._top], points[self._top_next])
-        n = np.column_stack([np.bincount(self._top_owner, weights=cross[:, k],
-                                         minlength=self.n_panels) for k in range(3)])
-        n /= np.maximum(np.linalg.norm(n, axis=1), 1e-300)[:, None]
-        return n, centre
+        normal, centre = np.empty((self.n_panels, 3)), np.empty((self.n_panels, 3))
+        kernels.normals(_positions(x), self.vertices, self.ptr, normal, centre)
+        return normal, centre
 
     def _centres(self, points: np.ndarray) -> np.ndarray:
         """(n_panels, 3) centroid of each panel's vertices, from ``points`` = x[vertices]."""
@@ -197,45 +182,16 @@ class PanelSolids:
         less a's highest is concave in the motion's parameter, so the smaller of
         its two end values bounds it, and so for a over b; the larger of those
         two bounds the gap. (The smaller of the two ends' gaps is not a bound: a
-        panel that passes through the other in one step is apart at both ends.)"""
-        if not len(pairs):
-            return np.zeros(0)
-        normal, centre = self.normals(x)
-        a, b = pairs[:, 0], pairs[:, 1]
-        axes = [normal[a], normal[b], normal[a] + normal[b], normal[a] - normal[b],
-                centre[b] - centre[a]]
-        if edges is not None:  # joined pairs: in-plane normals to their crease's edge
-            along = x[edges[:, 1]] - x[edges[:, 0]]
-            axes += [np.cross(normal[a], along), np.cross(normal[b], along)]
-        bound = np.full(len(pairs), -np.inf)
-        span_a, span_b = self._gathered(a), self._gathered(b)
-        for axis in axes:
-            length = np.linalg.norm(axis, axis=1)
-            usable = length > 1e-6
-            unit = axis / np.where(usable, length, 1.0)[:, None]
-            b_over_a = a_over_b = np.full(len(pairs), np.inf)
-            for y in (x,) if later is None else (x, later):
-                lo_a, hi_a = self._interval(y, span_a, unit)
-                lo_b, hi_b = self._interval(y, span_b, unit)
-                b_over_a, a_over_b = np.minimum(b_over_a, lo_b - hi_a), np.minimum(a_over_b,
-                                                                                 lo_a - hi_b)
-            gap = np.maximum(b_over_a, a_over_b)
-            bound = np.maximum(bound, np.where(usable, gap, -np.inf))
-        return bound
-
-    def _gathered(self, panels: np.ndarray):
-        """(vertex ids, pair row of each, start of each pair's run) of the panels."""
-        counts = np.diff(self.ptr)[panels]
-        rows = np.repeat(np.arange(len(panels)), counts)
-        start = np.concatenate([[0], np.cumsum(counts)[:-1]])
-        return self.vertices[_ranges(self.ptr[panels], counts)], rows, start
-
-    @staticmethod
-    def _interval(x, gathered, unit):
-        """(lo, hi) of each pair's panel vertices projected on its unit axis."""
-        verts, rows, start = gathered
-        s = np.einsum("ij,ij->i", x[verts], unit[rows])
-        return np.minimum.reduceat(s, start), np.maximum.reduceat(s, start)
+        panel that passes through the other in one step is apart at both ends.)
+        In numba: :func:`.kernels.gap_bounds`."""
+        out = np.empty(len(pairs))
+        if len(pairs):
+            x = _positions(x)
+            kernels.gap_bounds(x, x if later is None else _positions(later), later is not None,
+                               self.vertices, self.ptr, np.ascontiguousarray(pairs, np.int64),
+                               _NO_EDGES if edges is None else
+                               np.ascontiguousarray(edges, np.int64), out)
+        return out
 
     def shrunk(self, x: np.ndarray, share: float) -> np.ndarray:
         """(N, 3) x with every panel scaled by 1 − ``share`` about its vertices'
@@ -268,10 +224,10 @@ def _corners(ids: np.ndarray, rest: np.ndarray) -> np.ndarray:
     return np.concatenate([ids[:n][keep], ids[n:][keep]])
 
 
-def _ranges(starts: np.ndarray, counts: np.ndarray) -> np.ndarray:
-    """Concatenated aranges ``start … start + count − 1``, vectorised."""
-    total = int(counts.sum())
-    if not total:
-        return np.zeros(0, dtype=np.int64)
-    offsets = np.repeat(starts - np.concatenate([[0], np.cumsum(counts)[:-1]]), counts)
-    return np.arange(total, dtype=np.int64) + offsets
+def _positions(x: np.ndarray) -> np.ndarray:
+    """x as the kernels take it: (N, 3) float64, C-contiguous (a view where it is)."""
+    return np.ascontiguousarray(x, dtype=np.float64)
+
+
+_NO_EDGES = np.zeros((0, 2), dtype=np.int64)
+
