@@ -11,6 +11,7 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
+import numpy as np
 from numba import njit
 
 from elements.cache import choose_cache_dir
@@ -145,3 +146,42 @@ def gap_bounds(x, later, moving, vertices, ptr, pairs, edges, out):
                 best = max(best, _gap_along(x, later, moving, vertices, a0, a1, b0, b1, axis))
         out[k] = best
 
+
+@njit(cache=True)
+def boxes_near(lo, hi, margin, joined):
+    """(K, 2) int64 panel pairs (a < b, sorted by a · n_panels + b) whose boxes lo, hi
+    (n_panels, 3) come within ``margin`` mm of each other on every axis, less the
+    pairs whose code a · n_panels + b is in ``joined`` (sorted).
+
+    Sweep and prune: the boxes sorted by their low end along the axis their
+    centres spread widest on; each box is compared only with the boxes that
+    start before it ends there."""
+    n = len(lo)
+    spread, axis = -1.0, 0
+    for k in range(3):
+        centres = lo[:, k] + hi[:, k]
+        if centres.max() - centres.min() > spread:
+            spread, axis = centres.max() - centres.min(), k
+    order = np.argsort(lo[:, axis])
+    codes = []
+    for i in range(n):
+        p = order[i]
+        end = hi[p, axis] + margin
+        for j in range(i + 1, n):
+            q = order[j]
+            if lo[q, axis] > end:
+                break
+            if (lo[q, 0] > hi[p, 0] + margin or lo[p, 0] > hi[q, 0] + margin
+                    or lo[q, 1] > hi[p, 1] + margin or lo[p, 1] > hi[q, 1] + margin
+                    or lo[q, 2] > hi[p, 2] + margin or lo[p, 2] > hi[q, 2] + margin):
+                continue
+            code = min(p, q) * n + max(p, q)
+            m = np.searchsorted(joined, code)
+            if m < len(joined) and joined[m] == code:
+                continue
+            codes.append(code)
+    found = np.sort(np.array(codes, dtype=np.int64))
+    out = np.empty((len(found), 2), dtype=np.int64)
+    out[:, 0] = found // n
+    out[:, 1] = found % n
+    return out
