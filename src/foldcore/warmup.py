@@ -14,13 +14,17 @@ possible, so exactly the kernels the default path uses are compiled:
   report);
 * the same vertex, a few ``lbfgs`` and ``paper`` steps (the local/global
   kernels the hybrid strategy falls back to, the paper map's solution take);
-* a hinge with a bar of elastic cells (L-BFGS alone, the stops' check).
+* a hinge with a bar of elastic cells (L-BFGS alone, the stops' check);
+* where contact is installed (``ipctk``), the panel broad phase's kernels
+  (:func:`foldcore.contact.kernels.compile_all`: a first run with contact
+  would otherwise wait some 7 s for them).
 
 Kernels the default path never calls (stretch hinges, the hinges'
 unprepared ``batch``) are left to compile when a scene first needs them.
 """
 from __future__ import annotations
 
+import importlib.util
 import sys
 import time
 
@@ -42,6 +46,10 @@ def warm() -> dict:
     bar = patterns.single_hinge(panel_length=10.0, depth=5.0, angle=60.0, width=2.0)
     cells = thicken(bar, 1.0, elastic={1: 2})
     Simulation(cells, bar).run(tolerance=0, max_iterations=3)
+    if importlib.util.find_spec("ipctk") is not None:
+        from .contact.kernels import compile_all
+
+        compile_all()
     return {"seconds": time.perf_counter() - start, **_cache_counts()}
 
 

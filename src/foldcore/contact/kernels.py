@@ -185,3 +185,19 @@ def boxes_near(lo, hi, margin, joined):
     out[:, 0] = found // n
     out[:, 1] = found % n
     return out
+
+
+def compile_all() -> None:
+    """Call every kernel once on two unit cubes 1 mm apart, so numba compiles and
+    caches each (:mod:`foldcore.warmup`, where contact is installed): a first run
+    with contact would wait several seconds for them."""
+    square = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    cube = np.vstack([np.column_stack([square, np.ones(4)]), np.column_stack([square, np.zeros(4)])])
+    x = np.vstack([cube, cube + [2.0, 0.0, 0.0]])
+    vertices, ptr = np.arange(16, dtype=np.int64), np.array([0, 8, 16], dtype=np.int64)
+    lo, hi = np.empty((2, 3)), np.empty((2, 3))
+    boxes(x, vertices, ptr, lo, hi)
+    normals(x, vertices, ptr, np.empty((2, 3)), np.empty((2, 3)))
+    pairs = boxes_near(lo, hi, 1.0, np.zeros(0, dtype=np.int64))
+    gap_bounds(x, x, False, vertices, ptr, pairs, np.array([[1, 2]], dtype=np.int64),
+               np.empty(len(pairs)))
