@@ -291,9 +291,9 @@ def _add_scene(sub) -> None:
                      help="iteration strategy (default: the scene's own, see its docstring)")
     scn.add_argument("--quick", action="store_true",
                      help="lower iteration budgets (tests); same geometry")
-    scn.add_argument("--contact", choices=CONTACT_CHOICES, default="off",
+    scn.add_argument("--contact", choices=CONTACT_CHOICES,
                      help="on: panels never pass through each other (scenes of rigid "
-                          "panels); default off")
+                          "panels); default: the scene's own (on for gripper, else off)")
 
 
 def run_scene(args) -> int:
@@ -306,7 +306,7 @@ def run_scene(args) -> int:
     if not Path(args.out).is_dir():
         raise FoldcoreError(f"{args.out}: output folder does not exist")
     run = scenes.run(args.name, quick=args.quick, solver=args.solver,
-                     contact=args.contact == "on")
+                     contact=None if args.contact is None else args.contact == "on")
     for path in scenes.write(run, args.out, png=args.render):
         print(path)
     if not run.result.converged:

@@ -15,7 +15,8 @@ import sys
 import time
 from pathlib import Path
 
-DEMO_SCENES = ("d4v", "waterbomb", "miura", "hinge-study", "groove-bar", "chain", "box")
+DEMO_SCENES = ("d4v", "waterbomb", "miura", "hinge-study", "groove-bar", "chain", "box",
+               "gripper")
 
 
 def main(argv=None) -> int:

@@ -18,7 +18,7 @@ from .pattern import CreasePattern
 
 __all__ = ["degree4_vertex", "single_vertex", "waterbomb", "miura", "miura_edge_kinds",
            "miura_fold_angles", "miura_flat_widths", "miura_one_crease", "single_hinge", "grid",
-           "degree4_assignments", "wrapping_crease"]
+           "degree4_assignments", "wrapping_crease", "gripper", "gripper_leg_sector"]
 
 PEHRSON_SECTORS = (135.0, 90.0, 45.0, 90.0)
 PEHRSON_WIDTHS = (16.0, 4.0, 8.0, 4.0)
@@ -480,3 +480,83 @@ def grid(n: int, m: int, size: float = 10.0, assignment: str = "U") -> CreasePat
     interior = miura_edge_kinds(n, m) != "boundary"
     return CreasePattern(vertices, _lattice_edges(n, m),
                          np.where(interior, assignment, "B"), source="grid")
+
+
+# ---------------------------------------------------------------- gripper
+GRIPPER_SPINE_DEG, GRIPPER_LEG_DEG = 50.0, 110.0
+
+
+def gripper_leg_sector(spine: float = GRIPPER_SPINE_DEG, leg: float = GRIPPER_LEG_DEG) -> float:
+    """Sector γ (degrees) between a gripper vertex's valley spine and its legs for which
+    the spine pair folds by ``spine`` exactly when the legs fold by ``leg`` (degrees).
+
+    The vertex is a flat-foldable bird's foot, sectors (γ, 180−γ, 180−γ, γ), in
+    mode B of :func:`foldcore.kinematics.degree4_mode_b`:
+    tan(ρ_spine/2) = cos γ · tan(ρ_leg/2).
+    """
+    if not 0.0 < spine < leg < 180.0:
+        raise PatternError(f"gripper: need 0 < spine fold ({spine}°) < leg fold ({leg}°) "
+                           "< 180°")
+    return math.degrees(math.acos(math.tan(math.radians(spine) / 2)
+                                  / math.tan(math.radians(leg) / 2)))
+
+
+def gripper(half_width: float = 12.0, half_length: float = 30.0, offset: float = 3.0,
+            sector: float | None = None, spine_angle: float | None = GRIPPER_SPINE_DEG,
+            width: float = np.nan) -> CreasePattern:
+    """Two coupled bird's-foot vertices on a rectangle: a pop-up jaw mechanism.
+
+    The vertices A = (0, ``offset``) and B = (0, −``offset``) share the mountain
+    crease A–B (the *back*). From A a valley *spine* runs up the centre line to the
+    top edge and two mountain *legs* leave at ±γ from it to the side edges; B is A's
+    mirror image in y = 0. Folded, the two quadrilaterals above A's legs close on the
+    top spine into the upper jaw, those below B's legs into the lower jaw, and the
+    two *covers* between the legs turn about the back like the covers of a book:
+    closing the covers closes the jaws (one degree of freedom).
+
+    Parameters
+    ----------
+    half_width, half_length : float, mm
+        The sheet is [−half_width, half_width] × [−half_length, half_length].
+    offset : float, mm
+        Distance of each vertex from the sheet's centre (half the back's length).
+    sector : float, degrees, optional
+        γ between a spine and a leg, in (0, 90); default
+        :func:`gripper_leg_sector` (spines 50°, legs 110°).
+    spine_angle : float or None, degrees
+        Target fold magnitude of the spines and the back (None: passive); the legs'
+        target follows from the closed form (mode B), so the targets are compatible.
+    width : float, mm
+        Hinge width of every crease (NaN: auto).
+
+    Returns
+    -------
+    CreasePattern
+        Vertices 0 A, 1 B, 2 top spine end, 3 bottom spine end, 4/5 A's left/right
+        leg ends, 6/7 B's left/right leg ends, 8–11 the corners (+,+), (−,+), (−,−),
+        (+,−). Edges 0 top spine (V), 1 bottom spine (V), 2 back A–B (M), 3/4 A's
+        left/right legs (M), 5/6 B's left/right legs (M), then the boundary.
+        Faces: left and right halves of each jaw, left and right covers.
+    """
+    _check_positive(half_width=half_width, half_length=half_length, offset=offset)
+    gamma = gripper_leg_sector() if sector is None else float(sector)
+    if not 0.0 < gamma < 90.0:
+        raise PatternError(f"gripper: sector must be in (0, 90)°, got {gamma}")
+    rise = offset + half_width / math.tan(math.radians(gamma))
+    if not rise < half_length:
+        raise PatternError(f"gripper: legs at {gamma:.4g}° from the spines reach the "
+                           f"sides at |y| = {rise:.4g} mm, beyond half_length {half_length}")
+    w, h = half_width, half_length
+    vertices = [(0, offset), (0, -offset), (0, h), (0, -h), (-w, rise), (w, rise),
+                (-w, -rise), (w, -rise), (w, h), (-w, h), (-w, -h), (w, -h)]
+    creases = [(0, 2), (1, 3), (0, 1), (0, 4), (0, 5), (1, 6), (1, 7)]
+    ring = [2, 9, 4, 6, 10, 3, 11, 7, 5, 8]
+    boundary = list(zip(ring, ring[1:] + ring[:1]))
+    angles = [None] * 7
+    if spine_angle is not None:
+        rho = kinematics.degree4_deg(gamma, 180.0 - gamma, float(spine_angle), "B")
+        spine, leg = float(rho[0]), float(rho[1])
+        angles = [spine, spine, -spine, leg, leg, leg, leg]
+    return CreasePattern(vertices, creases + boundary, ["V", "V", "M"] + ["M"] * 4 + ["B"] * 10,
+                         fold_angles=angles + [None] * 10,
+                         widths=[width] * 7 + [None] * 10, source="gripper")

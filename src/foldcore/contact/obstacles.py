@@ -85,6 +85,25 @@ class Obstacle:
         corners = [p + half * (a * u + b * w) for a, b in ((-1, -1), (1, -1), (1, 1), (-1, 1))]
         return cls(np.array(corners), np.array([[0, 1, 2], [0, 2, 3]]), name)
 
+    @classmethod
+    def ball(cls, centre, radius: float, subdivisions: int = 2,
+             name: str = "ball") -> "Obstacle":
+        """A ball of ``radius`` (mm) about ``centre`` (mm): an icosahedron whose
+        triangles are split in four ``subdivisions`` times, its vertices on the
+        sphere (20·4^k faces; the flat faces lie inside the sphere by at most
+        about 5 % of the radius at k = 2)."""
+        c = np.asarray(centre, dtype=float)
+        if c.shape != (3,) or not np.isfinite(c).all():
+            raise ObstacleError(f"{name}: centre must be 3 finite numbers")
+        if not (np.isfinite(radius) and radius > 0) or int(subdivisions) != subdivisions \
+                or not 0 <= subdivisions <= 5:
+            raise ObstacleError(f"{name}: needs a radius > 0 and 0 ≤ subdivisions ≤ 5")
+        vertices, faces = _icosahedron()
+        for _ in range(int(subdivisions)):
+            vertices, faces = _split_in_four(vertices, faces)
+        unit = vertices / np.linalg.norm(vertices, axis=1)[:, None]
+        return cls(c + radius * unit, faces, name)
+
 
 def read_obstacle(path, name: str | None = None) -> Obstacle:
     """An obstacle from a mesh file meshio reads (STL, OBJ, PLY, VTK, …), in mm;
@@ -226,3 +245,28 @@ class ObstacleContacts:
             if ipctk.has_intersections(mesh, local) or len(collisions):
                 out.append((p, o))
         return out
+
+
+def _icosahedron() -> tuple[np.ndarray, np.ndarray]:
+    """(12, 3) vertices and (20, 3) outward triangles of a regular icosahedron."""
+    g = (1.0 + 5.0 ** 0.5) / 2.0
+    v = np.array([(-1, g, 0), (1, g, 0), (-1, -g, 0), (1, -g, 0), (0, -1, g), (0, 1, g),
+                  (0, -1, -g), (0, 1, -g), (g, 0, -1), (g, 0, 1), (-g, 0, -1), (-g, 0, 1)],
+                 dtype=float)
+    f = np.array([(0, 11, 5), (0, 5, 1), (0, 1, 7), (0, 7, 10), (0, 10, 11), (1, 5, 9),
+                  (5, 11, 4), (11, 10, 2), (10, 7, 6), (7, 1, 8), (3, 9, 4), (3, 4, 2),
+                  (3, 2, 6), (3, 6, 8), (3, 8, 9), (4, 9, 5), (2, 4, 11), (6, 2, 10),
+                  (8, 6, 7), (9, 8, 1)])
+    return v, f
+
+
+def _split_in_four(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Each triangle split into four at its edges' midpoints (shared midpoints once)."""
+    edges = np.sort(np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]]), axis=1)
+    unique, index = np.unique(edges, axis=0, return_inverse=True)
+    mid = len(vertices) + index.reshape(3, -1).T  # (F, 3): midpoints of edges 01, 12, 20
+    out = np.vstack([vertices, 0.5 * (vertices[unique[:, 0]] + vertices[unique[:, 1]])])
+    a, b, c = faces.T
+    ab, bc, ca = mid.T
+    return out, np.concatenate([np.column_stack(t) for t in
+                                ((a, ab, ca), (ab, b, bc), (ca, bc, c), (ab, bc, ca))])

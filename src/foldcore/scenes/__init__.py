@@ -5,8 +5,9 @@ the paper reports, beside the closed forms of :mod:`foldcore.kinematics` where t
 >>> run = scenes.run("d4v", quick=True)          # doctest: +SKIP
 >>> run.quantities["flat"]["fold_angles_deg"]     # doctest: +SKIP
 
-Every scene module defines ``run(quick=False, solver=None) -> SceneRun`` and
-``headline(quantities) -> str`` (one line for the demo);
+Every scene module defines ``run(quick=False, solver=None, contact=False) ->
+SceneRun`` and ``headline(quantities) -> str`` (one line for the demo), and may
+set ``CONTACT = True`` where contact is what it shows;
 ``quick`` lowers iteration budgets for tests, never the geometry. Which
 scenes exist is known without importing them (``NAMES``), so the CLI's
 ``--help`` and this package stay light.
@@ -28,6 +29,8 @@ NAMES = {
     "groove-bar": "elastic bar with a 90° V-groove joint pulled past its limit",
     "chain": "linear chain of spherical mechanisms (Miura strip) pushed across one end",
     "box": "five-crease hexagonal box (reconstructed) folded at H = 1 and 4 mm: volumes",
+    "gripper": "jaws of two coupled spherical mechanisms (reconstructed), squeezed shut "
+               "and on a ball",
 }
 
 
@@ -64,7 +67,7 @@ class SceneRun:
 
 
 def run(name: str, quick: bool = False, solver: str | None = None,
-        contact: bool = False) -> SceneRun:
+        contact: bool | None = None) -> SceneRun:
     """Run scene ``name`` (see ``NAMES``).
 
     Parameters
@@ -73,11 +76,15 @@ def run(name: str, quick: bool = False, solver: str | None = None,
         Lower iteration budgets (tests); the geometry is unchanged.
     solver : str, optional
         Strategy (``foldcore.strategies.SOLVERS``); default: the scene's own.
-    contact : bool
+    contact : bool, optional
         Keep panels from passing through each other (:mod:`foldcore.contact`;
-        scenes of rigid panels, strategies that take it).
+        scenes of rigid panels, strategies that take it); None: the scene's own
+        choice (its ``CONTACT``, off unless the scene is about contact).
     """
-    return _module(name).run(quick=quick, solver=solver, contact=contact)
+    module = _module(name)
+    if contact is None:
+        contact = getattr(module, "CONTACT", False)
+    return module.run(quick=quick, solver=solver, contact=contact)
 
 
 def headline(name: str, quantities: dict) -> str:
