@@ -44,8 +44,14 @@ MAX_STIFFENING = 1e8
 
 
 def _ipctk():
+    """ipctk, its sums pinned to one thread: with its default threads the same run
+    gave different results at rounding level from one time to the next (reductions
+    in a varying order), which contact's cut steps carry on to the fold; each call
+    here works on one small pair mesh, where its threads buy nothing."""
     import ipctk  # an import only runs that ask for contact pay for
 
+    if ipctk.get_num_threads() != 1:
+        ipctk.set_num_threads(1)
     return ipctk
 
 
