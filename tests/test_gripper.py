@@ -89,6 +89,14 @@ def test_the_jaws_stop_on_each_other(with_contact):
     assert touched[-1]["contact"]["upper_jaw_force"] == pytest.approx(
         touched[-1]["contact"]["lower_jaw_force"], rel=0.1)
     assert _overlaps(with_contact, with_contact.result.positions) <= 1e-4
+    # pushed on past the touch, the handles are held back and the report says by what
+    assert steps[-1]["handles_stopped_by"] == ["contact"]
+    assert all(s["handles_stopped_by"] == [] for s in steps if s["handle_miss_mm"] < 0.01)
+    from foldcore.outputs import run_summary
+
+    _, warnings = run_summary(with_contact.result, with_contact.pattern, "gripper", 100.0)
+    assert any("contact holds 2 position targets back" in w for w in warnings)
+    assert not any("no crease is driven" in w for w in warnings)
 
 
 def test_the_jaws_stop_on_the_ball_and_press_it_harder_as_the_push_goes_on(with_contact):

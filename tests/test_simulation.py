@@ -308,3 +308,22 @@ def test_k_is_factorised_at_its_first_use_and_then_matches_the_current_weights()
     fresh = Factor(sim.system.with_pins(), sim.system.backend)
     np.testing.assert_allclose(sim.system.factor.solve(rhs), fresh.solve(rhs), rtol=1e-10,
                                atol=1e-12 * np.abs(fresh.solve(rhs)).max())
+
+
+def test_the_result_says_how_far_each_position_target_is_and_why():
+    """The left panel held, a right corner lifted where the hinge can take it: met
+    (stopped_by None); pulled away in the sheet's plane, which would stretch the
+    rigid panels and the hinge: a compromise with them ("pull")."""
+    pattern, mesh = hinge(assignment="U")
+    sim = Simulation(mesh, pattern)
+    x = sim.positions
+    sim.add_position_target(np.flatnonzero(x[:, 0] < -0.6 * PANEL), name="held")
+    corner = sim.nearest_vertex([PANEL, 2.0, H / 2])
+    sim.add_position_target([corner], x[corner] + [0.0, 0.0, 0.5], name="lift")
+    met = {t["name"]: t for t in converge(sim).position_targets}
+    assert met["lift"]["vertices"] == 1 and met["lift"]["stopped_by"] is None
+    assert met["held"]["stopped_by"] is None
+    sim.move_position_target("lift", x[corner] + [2.0, 0.0, 0.0])
+    pulled = {t["name"]: t for t in converge(sim).position_targets}
+    assert pulled["lift"]["stopped_by"] == "pull" and 0.1 < pulled["lift"]["miss_mm"] < 2.0
+    assert Simulation(mesh, pattern).run(max_iterations=2).position_targets is None

@@ -112,7 +112,7 @@ def run_summary(result, pattern, source: str, fold_percent: float,
     if driven:
         line += f", miss max {worst:.3g}°, median {entries['median_miss_deg']:.3g}°"
     warns = []
-    if not driven:
+    if not driven and not getattr(result, "position_targets", None):
         warns.append(f"{source}: no crease is driven (no target angles): the sheet stays "
                      "as it is; give edges_foldAngle, or M/V creases without angles "
                      "(and not reading.mv_without_angle='passive')")
@@ -126,6 +126,14 @@ def run_summary(result, pattern, source: str, fold_percent: float,
                      + (", …" if len(blocked) > 10 else "") + "): their panels touch "
                      f"others ({near}); the report's contact section "
                      "lists the touching panels and their forces")
+    held = [t for t in (getattr(result, "position_targets", None) or [])
+            if t["stopped_by"] == "contact"]
+    if held:
+        warns.append(f"{source}: contact holds {len(held)} position target"
+                     + ("s" if len(held) > 1 else "") + " back ("
+                     + ", ".join(f"{t['name']} by {t['miss_mm']:.3g} mm" for t in held[:5])
+                     + (", …" if len(held) > 5 else "") + "): panels touch on the way; "
+                     "the report's contact section lists them and their forces")
     if driven and entries["binding"]:
         missed, wrong = entries["missed"] - len(entries["contact_blocked"]), entries["wrong_side"]
         warns.append(f"{source}: converged, but {missed} of {driven} driven creases miss "
@@ -227,6 +235,8 @@ def report_dict(result, pattern, mesh, settings: dict, quantities: dict | None =
         "actuation": actuation_entries(result, pattern),
         "hinges": hinge_entries(result, pattern, mesh),
         **({"contact": result.contact} if result.contact is not None else {}),
+        **({"position_targets": result.position_targets}
+           if getattr(result, "position_targets", None) else {}),
         "strip_angles_deg": result.strip_angles_deg.tolist(),
         **_strain_entries(result),
         "vertices": int(mesh.n_vertices),

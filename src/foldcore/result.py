@@ -48,6 +48,13 @@ class Result:
         ``stiffness`` (κ, mm³), ``touching_faces`` and ``panel_forces``
         (per touching panel its face and the contact force, −∂(κ Σ b)/∂x summed
         over its vertices, mm⁴)
+    position_targets : list of dict or None, per position target at the end:
+        ``name``, ``vertices`` (count), ``alpha``, ``miss_mm`` and
+        ``mean_miss_mm`` (its vertices' largest and mean distance from their
+        targets) and ``stopped_by``: ``"contact"`` where it misses by more than
+        :data:`foldcore.simulation.TARGET_MISS` of the pattern's size while
+        panels touch, ``"pull"`` where it misses so with nothing touching (a
+        compromise with the hinges or with other targets), else None
     """
 
     positions: np.ndarray
@@ -64,3 +71,4 @@ class Result:
     reason: str = "none"
     residual: float = float("nan")
     contact: dict | None = None
+    position_targets: list | None = None

@@ -393,7 +393,8 @@ class Simulation:
                       list(self._monitor.failures) if self._monitor is not None else [],
                       model.target_angles(), model.hinge_misfits(),
                       reason or ("converged" if converged else "none"),
-                      float(self.convergence.residual), contact_summary(model))
+                      float(self.convergence.residual), contact_summary(model),
+                      position_target_entries(model))
 
     @property
     def failures(self) -> list:
@@ -463,6 +464,29 @@ def contact_model(model, strategy, contact, obstacles=()):
                               f"move it clear of the sheet (its faces are at ±H/2 = "
                               f"±{0.5 * model.mesh.thickness:g} mm)")
     return built
+
+
+#: A position target "misses" beyond this share of the pattern's size (Result).
+TARGET_MISS = 1e-3
+
+
+def position_target_entries(model) -> list | None:
+    """:attr:`Result.position_targets` at the model's positions (None: no targets)."""
+    targets = model.pins.targets
+    if not targets:
+        return None
+    touching = False
+    if model.contact is not None:
+        state = model.contact.state(model.x)
+        touching = state.active or bool(model.contact.blocking)
+    limit = TARGET_MISS * model.length_scale
+    out = []
+    for name, (worst, mean) in model.pins.misses(model.x).items():
+        stopped = None if worst <= limit else ("contact" if touching else "pull")
+        out.append({"name": name, "vertices": int(len(targets[name].vertices)),
+                    "alpha": targets[name].alpha, "miss_mm": worst, "mean_miss_mm": mean,
+                    "stopped_by": stopped})
+    return out
 
 
 def contact_summary(model) -> dict | None:

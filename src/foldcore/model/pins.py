@@ -104,6 +104,15 @@ class Pins:
             energy += w * float(((x[t.vertices] - t.positions) ** 2).sum())
         return energy
 
+    def misses(self, x: np.ndarray) -> dict:
+        """{name: (largest, mean) distance (mm) of a target's vertices at x (N, 3) from
+        their target positions}."""
+        out = {}
+        for name, t in self._targets.items():
+            d = np.linalg.norm(x[t.vertices] - t.positions, axis=1)
+            out[name] = (float(d.max()), float(d.mean()))
+        return out
+
     def fading(self) -> bool:
         """Whether some target's α decays (a pull-and-release schedule)."""
         return any(t.decay < 1.0 for t in self._targets.values())

@@ -44,8 +44,10 @@ Contact is on by default in this scene (``contact=False``: the jaws pass
 through each other, which is what the quantities then say).
 
 Quantities per step: the handles' turn (degrees), travel (mm, both outer
-edges' midpoints from where they started, summed) and miss (mm, the largest
-distance of a handle vertex from its target), the jaw tip distance (mm, between
+edges' midpoints from where they started, summed), miss (mm, the largest
+distance of a handle vertex from its target) and what stopped them
+(``Result.position_targets``: ``contact`` once they miss by more than
+10⁻³ of the sheet's size while panels touch), the jaw tip distance (mm, between
 the two jaws' mid-surface points at their spine ends), the thin-limit tip
 distance at the achieved leg angle (the formula above), the back, spine and
 leg angles, the smallest contact gap (mm) and the contact force on each jaw
@@ -173,6 +175,8 @@ def _row(turn, result, parts, starts, targets, done) -> dict:
            "back_deg": round(float(angles[BACK]), 3),
            "spine_deg": round(float(angles[TOP_SPINE]), 3),
            "legs_deg": rounded(angles[LEG:LEG + 4], 3),
+           "handles_stopped_by": sorted({t["stopped_by"] for t in result.position_targets
+                                         if t["stopped_by"]}),
            "iterations": int(result.iterations) - done, "reason": result.reason}
     if result.contact is not None:
         row["contact"] = _contact(result.contact)
