@@ -125,14 +125,16 @@ TILE, TILES_PER_ROW = (320, 240), 6
 
 def gallery_image(gallery: list) -> np.ndarray:
     """(H, W, 3) uint8: each (title, pattern, mesh, positions) rendered in a tile of
-    ``TILE`` pixels, ``TILES_PER_ROW`` to a row (white where a row is short)."""
+    ``TILE`` pixels, ``TILES_PER_ROW`` to a row (fewer: one row of them; white where
+    the last row is short)."""
     from ..animate import render_frames
 
     tiles = [render_frames(pattern, mesh, [positions], size=TILE, titles=[title],
                            progress=False)[0] for title, pattern, mesh, positions in gallery]
+    per_row = min(TILES_PER_ROW, len(tiles))  # a short gallery is one row of its own width
     rows = []
-    for start in range(0, len(tiles), TILES_PER_ROW):
-        row = tiles[start:start + TILES_PER_ROW]
-        row += [np.full_like(tiles[0], 255)] * (TILES_PER_ROW - len(row))
+    for start in range(0, len(tiles), per_row):
+        row = tiles[start:start + per_row]
+        row += [np.full_like(tiles[0], 255)] * (per_row - len(row))
         rows.append(np.hstack(row))
     return np.vstack(rows)
