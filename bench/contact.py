@@ -48,13 +48,9 @@ H = 1.0
 
 
 def letter_pattern():
-    from foldcore.pattern import CreasePattern
+    from foldcore import patterns
 
-    xs = [0.0, 6.0, 16.0, 22.0]
-    v = [(x, 0.0) for x in xs] + [(x, 10.0) for x in xs]
-    e = [(1, 5), (2, 6), (0, 1), (1, 2), (2, 3), (4, 5), (5, 6), (6, 7), (0, 4), (3, 7)]
-    return CreasePattern(np.array(v), np.array(e), np.array(["V", "V"] + ["B"] * 8),
-                         source="letter")
+    return patterns.panel_row([6.0, 10.0, 6.0])
 
 
 def worst_overlap(mesh, positions) -> float:

@@ -28,7 +28,7 @@ pytest.importorskip("ipctk")
 from foldcore.contact import Obstacle, ObstacleError, read_obstacle  # noqa: E402
 from foldcore.errors import SimulationError  # noqa: E402
 from foldcore.io import write_fold  # noqa: E402
-from foldcore.pattern import CreasePattern  # noqa: E402
+from foldcore import patterns  # noqa: E402
 from foldcore.simulation import Simulation  # noqa: E402
 from foldcore.thickening import thicken  # noqa: E402
 
@@ -39,11 +39,7 @@ GAP = 0.05  # mm between the sheet and each obstacle at the start
 
 
 def letter():
-    xs = [0.0, 4.0, 16.0, 20.0]
-    v = [(x, 0.0) for x in xs] + [(x, 10.0) for x in xs]
-    e = [(1, 5), (2, 6), (0, 1), (1, 2), (2, 3), (4, 5), (5, 6), (6, 7), (0, 4), (3, 7)]
-    return CreasePattern(np.array(v), np.array(e), np.array(["V", "V"] + ["B"] * 8),
-                         source="letter")
+    return patterns.panel_row([4.0, 12.0, 4.0])
 
 
 def cube(centre=(10.0, 5.0, 0.5 * H + GAP + 1.5), half=(4.5, 3.0, 1.5)) -> Obstacle:

@@ -238,3 +238,14 @@ def test_single_vertex_of_degree_five_and_its_refusals():
         p.single_vertex((120.0, 90.0, 30.0, 30.0, 90.0), list("VVVM"))
     with pytest.raises(PatternError, match="at least 3"):
         p.single_vertex((180.0, 180.0), list("VV"))
+
+
+def test_a_panel_row_puts_its_creases_first_and_its_panels_side_by_side():
+    row = p.panel_row([6.0, 10.0, 6.0], depth=10.0)
+    assert [tuple(e) for e in row.edges[:2]] == [(1, 5), (2, 6)]
+    assert list(row.assignments) == ["V", "V"] + ["B"] * 8
+    assert len(row.faces) == 3 and row.area() == pytest.approx(220.0)
+    with pytest.raises(PatternError, match=r"lengths\[1\] must be > 0"):
+        p.panel_row([6.0, 0.0])
+    with pytest.raises(PatternError, match="at least 2"):
+        p.panel_row([6.0])

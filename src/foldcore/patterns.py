@@ -18,7 +18,7 @@ from .pattern import CreasePattern
 
 __all__ = ["degree4_vertex", "single_vertex", "waterbomb", "miura", "miura_edge_kinds",
            "miura_fold_angles", "miura_flat_widths", "miura_one_crease", "single_hinge", "grid",
-           "degree4_assignments", "wrapping_crease", "gripper", "gripper_leg_sector"]
+           "degree4_assignments", "wrapping_crease", "gripper", "gripper_leg_sector", "panel_row"]
 
 PEHRSON_SECTORS = (135.0, 90.0, 45.0, 90.0)
 PEHRSON_WIDTHS = (16.0, 4.0, 8.0, 4.0)
@@ -464,6 +464,42 @@ def single_hinge(panel_length: float = 10.0, depth: float = 10.0, angle=None,
     return CreasePattern(vertices, edges, [assignment] + ["B"] * 6,
                          fold_angles=[angle] + [None] * 6, widths=[width] + [None] * 6,
                          max_angles=[max_angle] + [180.0] * 6, source="single_hinge")
+
+
+def panel_row(lengths, depth: float = 10.0, assignment: str = "V") -> CreasePattern:
+    """Rectangular panels side by side along x, each crease between two of them (a
+    letter fold: three panels, two creases).
+
+    Parameters
+    ----------
+    lengths : k floats, mm
+        Each panel's extent along x (k ≥ 2), left to right.
+    depth : float, mm
+        Crease length (the panels' extent along y).
+    assignment : {"V", "M", "U", "F"}
+        Of every crease; no target angles (passive).
+
+    Returns
+    -------
+    CreasePattern
+        Vertices 0 … k along y = 0 at the panels' sides (x = 0, L₁, L₁ + L₂, …),
+        then k + 1 … 2k + 1 above them at y = ``depth``. Edges 0 … k − 2 the
+        creases i+1 → i+k+2, then the boundary: bottom left to right, top left to
+        right, left side, right side. Faces: the panels.
+    """
+    lengths = np.asarray(lengths, dtype=float)
+    if lengths.ndim != 1 or len(lengths) < 2:
+        raise PatternError(f"panel_row: need at least 2 panel lengths, got {lengths.size}")
+    _check_positive(depth=depth, **{f"lengths[{i}]": v for i, v in enumerate(lengths)})
+    xs = np.concatenate([[0.0], np.cumsum(lengths)])
+    k = len(lengths)
+    vertices = [(x, 0.0) for x in xs] + [(x, depth) for x in xs]
+    creases = [(i, i + k + 1) for i in range(1, k)]
+    bottom = [(i, i + 1) for i in range(k)]
+    top = [(i + k + 1, i + k + 2) for i in range(k)]
+    edges = creases + bottom + top + [(0, k + 1), (k, 2 * k + 1)]
+    return CreasePattern(vertices, edges, [assignment] * len(creases) + ["B"] * (2 * k + 2),
+                         source="panel_row")
 
 
 def grid(n: int, m: int, size: float = 10.0, assignment: str = "U") -> CreasePattern:
