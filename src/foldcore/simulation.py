@@ -387,14 +387,15 @@ class Simulation:
             self._monitor.check(model.x, self.progress.iterations, model.fold_percent)
         timings = {k: float(v) for k, v in self.timings.items()}
         timings.setdefault("total", sum(timings.values()))
+        contact = contact_summary(model)
         return Result(model.x.copy(), model.fold_angles(), model.strip_angles(),
                       np.array(self.progress.energies), self.progress.iterations, converged,
                       timings, model.strip_strains(),
                       list(self._monitor.failures) if self._monitor is not None else [],
                       model.target_angles(), model.hinge_misfits(),
                       reason or ("converged" if converged else "none"),
-                      float(self.convergence.residual), contact_summary(model),
-                      position_target_entries(model))
+                      float(self.convergence.residual), contact,
+                      position_target_entries(model, contact))
 
     @property
     def failures(self) -> list:
@@ -470,15 +471,14 @@ def contact_model(model, strategy, contact, obstacles=()):
 TARGET_MISS = 1e-3
 
 
-def position_target_entries(model) -> list | None:
-    """:attr:`Result.position_targets` at the model's positions (None: no targets)."""
+def position_target_entries(model, contact: dict | None) -> list | None:
+    """:attr:`Result.position_targets` at the model's positions (None: no targets);
+    ``contact``: :func:`contact_summary` there (its touching faces: panels within
+    the barrier's reach, on an obstacle, or cutting the last step)."""
     targets = model.pins.targets
     if not targets:
         return None
-    touching = False
-    if model.contact is not None:
-        state = model.contact.state(model.x)
-        touching = state.active or bool(model.contact.blocking)
+    touching = bool(contact and contact["touching_faces"])
     limit = TARGET_MISS * model.length_scale
     out = []
     for name, (worst, mean) in model.pins.misses(model.x).items():
