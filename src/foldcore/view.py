@@ -13,12 +13,21 @@ strain (dark to yellow, 0 to the largest over the frames; as ``foldcore render
 chooses the first view (used by the tests). Geometry: the outer surface of
 the thick mesh rebuilt from the file (:func:`foldcore.result_file.read_result`),
 float32 positions per frame, base64-encoded.
+
+Nothing from the file becomes markup or script: the values are those
+``read_result`` checked (types, shapes, ranges), they reach the page only as
+JSON in a ``<script type="application/json">`` element, escaped so that no
+string can end it (:func:`script_json`), read with ``JSON.parse``; the page
+shows text with ``textContent``, and the file's name in ``<title>`` is
+HTML-escaped.
 """
 from __future__ import annotations
 
 import base64
+import html
 import json
 import os
+import re
 from pathlib import Path
 
 import numpy as np
@@ -31,21 +40,27 @@ KINDS = {"M": 1, "V": 2, "F": 3}  # anything else on a hinge: 4 (undriven)
 def view_html(path, output) -> None:
     """Write the viewer page of the result file ``path`` to ``output`` (atomically).
 
+    Every value shown comes from :func:`foldcore.result_file.read_result`, which
+    checks each folded frame (coordinates finite and within
+    ±``MAX_FRAME_COORDINATE_MM`` mm, titles text of at most ``MAX_TITLE_CHARS``
+    characters, angles null or within ±180°, one per crease); it reaches the
+    page only as JSON escaped for a ``<script>`` element (:func:`script_json`),
+    and the page shows text with ``textContent`` only.
+
     Raises
     ------
     PatternError
-        ``path`` is not a result file foldcore can rebuild, or a folded frame does
-        not match the rebuilt mesh.
+        ``path`` is not a result file foldcore can rebuild, or a folded frame is
+        malformed, out of range or does not match the rebuilt mesh; nothing is
+        written.
     """
     from .files import write_text
-    from .io.fold import read_bytes
     from .mesh import surface_polygons
     from .result_file import read_result
     from .surface import surface_triangles
 
     source = os.fspath(path)
     res = read_result(source)
-    d = json.loads(read_bytes(source))
     surface = surface_polygons(res.mesh)
     triangles, face = surface_triangles(res.mesh, surface, return_faces=True, source=source)
     crease = np.where(surface.is_hinge[face], surface.source[face], -1).astype(np.int32)
@@ -54,19 +69,51 @@ def view_html(path, output) -> None:
     kind[hinge] = [KINDS.get(str(res.pattern.assignments[e]), 4) for e in crease[hinge]]
     bending = surface.group[face] == "bending_hinge"
     strip = np.where(bending, surface.element[face], -1).astype(np.int32)
-    frames = _frames(d, res.mesh.n_vertices, source)
-    for frame, xyz in frames:
-        frame["strain"] = _b64(_strip_strains(res.mesh, xyz).astype("<f4"))
     data = {"triangles": _b64(triangles.astype("<u4")), "kind": _b64(kind),
             "crease": _b64(crease.astype("<i4")), "strip": _b64(strip),
-            "frames": [frame for frame, _ in frames]}
-    page = (ASSETS / "view.html").read_text()
-    page = page.replace("__TITLE__", f"foldcore: {Path(source).name}")
-    page = page.replace("__IMPORTMAP__", json.dumps({"imports": {
-        "three": _module_url("three.module.min.js"),
-        "three/addons/controls/OrbitControls.js": _module_url("OrbitControls.js")}}))
-    page = page.replace("__DATA__", json.dumps(data))
-    write_text(output, page)
+            "frames": [_page_frame(frame, res.mesh) for frame in res.frames]}
+    write_text(output, _page(source, data))
+
+
+def _page(source: str, data: dict) -> str:
+    """The page of ``data`` (:func:`view_html`) from ``viewer_assets/view.html``: its
+    placeholders replaced in one pass (a value holding a placeholder's name stays
+    as it is), the file's name escaped as HTML text, the rest as :func:`script_json`."""
+    name = Path(source).name.encode("utf-8", "replace").decode("utf-8")  # undecodable: ?
+    values = {"__TITLE__": html.escape(f"foldcore: {name}"),
+              "__IMPORTMAP__": script_json({"imports": {
+                  "three": _module_url("three.module.min.js"),
+                  "three/addons/controls/OrbitControls.js": _module_url("OrbitControls.js")}}),
+              "__DATA__": script_json(data)}
+    template = (ASSETS / "view.html").read_text()
+    return re.sub("|".join(values), lambda m: values[m.group(0)], template)
+
+
+#: Characters that could end a ``<script>`` element, open a comment in it, or end a
+#: JavaScript line inside a string, and their JSON escapes.
+SCRIPT_ESCAPES = {"<": "\\u003c", ">": "\\u003e", "&": "\\u0026", "\u2028": "\\u2028",
+                  "\u2029": "\\u2029"}
+
+
+def script_json(value) -> str:
+    """``value`` as JSON text safe inside an HTML ``<script>`` element.
+
+    The same JSON, with ``<``, ``>``, ``&``, U+2028 and U+2029 written as
+    ``\\uXXXX`` escapes (they can only occur inside JSON strings), so no value
+    can close the element or open markup; NaN and infinities are refused
+    (``ValueError``), as JSON has none.
+    """
+    text = json.dumps(value, allow_nan=False)
+    return re.sub("[<>&\u2028\u2029]", lambda m: SCRIPT_ESCAPES[m.group(0)], text)
+
+
+def _page_frame(frame, mesh) -> dict:
+    """The page's entry of one :class:`~foldcore.result_file.FoldedFrame`: title,
+    (N·3) float32 positions and (S,) float32 sub-strip strains (base64), and the
+    achieved angle per crease (degrees, null where none)."""
+    return {"title": frame.title, "xyz": _b64(frame.positions.astype("<f4")),
+            "strain": _b64(_strip_strains(mesh, frame.positions).astype("<f4")),
+            "angles": [None if np.isnan(a) else float(a) for a in frame.angles.tolist()]}
 
 
 def _strip_strains(mesh, positions: np.ndarray) -> np.ndarray:
@@ -78,27 +125,6 @@ def _strip_strains(mesh, positions: np.ndarray) -> np.ndarray:
     if hinges is None or not len(hinges):
         return np.zeros(0)
     return strip_strains(hinges.params, estimated_strip_angles(hinges, positions)).max(axis=1)
-
-
-def _frames(d: dict, n_vertices: int, source: str) -> list:
-    """Every folded frame of the file with the mesh's vertex count, in order, as (page
-    entry, positions): title, (N·3) float32 positions (base64) and per key-frame edge
-    achieved angles; positions (N, 3) mm."""
-    from .errors import PatternError
-    from .outputs import SERIES_ANGLE_KEY
-
-    out = []
-    for i, f in enumerate(d.get("file_frames") or []):
-        if not isinstance(f, dict) or "foldedForm" not in (f.get("frame_classes") or []):
-            continue
-        xyz = np.asarray(f.get("vertices_coords"), dtype=np.float64)
-        if xyz.shape != (n_vertices, 3):
-            raise PatternError(f"{source}: file_frames[{i}] has {len(xyz)} vertices, the "
-                               f"rebuilt thick mesh {n_vertices}")
-        angles = f.get(SERIES_ANGLE_KEY, d.get("edges_foldAngle"))
-        out.append(({"title": str(f.get("frame_title", f"frame {i}")),
-                     "xyz": _b64(xyz.astype("<f4")), "angles": angles}, xyz))
-    return out
 
 
 def _b64(array: np.ndarray) -> str:
