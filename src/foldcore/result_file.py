@@ -29,10 +29,11 @@ from .io.fold import edges_poisson, faces_cells, fold_file_from_dict, read_bytes
 from .io.fold_json import (ARRAY, UNIT_MM, check_length, fail, index, number, number_table,
                            parse_json, short)
 
-#: Largest |coordinate| of a folded frame's vertex, mm (after ``frame_unit``): far
-#: beyond any sheet the pattern reader accepts (at most 1e7 mm across, and refused
-#: as zero-area faces once moved about 1e8 × its extent off the origin), far inside
-#: float32 (3.4e38), in which the viewer page holds positions.
+#: Largest |coordinate| of a folded frame's vertex, mm (after ``frame_unit``): the
+#: largest sheet accepted (1e7 mm across, ``limits.LENGTH_MM``) moved 1e8 × its
+#: extent off the origin, where a sheet's faces are already refused as zero-area
+#: (docs/architecture.md#accepted-ranges-of-inputs); far inside float32 (3.4e38),
+#: in which the viewer page holds positions.
 MAX_FRAME_COORDINATE_MM = 1e15
 #: Longest ``frame_title`` accepted, characters.
 MAX_TITLE_CHARS = 200
