@@ -6,13 +6,17 @@ are loaded in headless Chromium (as in ``tests/test_view.py``); an injected
 script would mark the page (``document.title = 'PWNED'``, a ``data-pwned``
 attribute on the body), which the dumped DOM must not show.
 
-The generated files (:func:`hostile_results`) each carry one value the viewer
+The generated files of :func:`hostile_results` each carry one value the viewer
 must not take (huge integers, NaN/inf, 1e308, wrong shapes and types, missing
-coordinates, a frame of another vertex count, non-list values): 300 per run in
-CI (derandomized), ``FOLDCORE_FUZZ=long`` 10 000, ``FOLDCORE_FUZZ=N`` N.
+coordinates, a frame of another vertex count, non-list values) and must be
+refused; those of :func:`corrupted_series` (the mutations of
+``tests/test_fuzz_results.py``, in any frame) must give a page whose values are
+in range or be refused. 300 of each per run in CI (derandomized),
+``FOLDCORE_FUZZ=long`` 10 000, ``FOLDCORE_FUZZ=N`` N.
 """
 from __future__ import annotations
 
+import base64
 import copy
 import html
 import json
@@ -20,15 +24,17 @@ import math
 import subprocess
 import sys
 
+import numpy as np
 import pytest
-from hypothesis import given
+from hypothesis import event, given
 from hypothesis import strategies as st
 
 from foldcore import patterns
 from foldcore.cli import main
 from foldcore.io import write_fold
-from foldcore.result_file import MAX_TITLE_CHARS
-from test_fuzz_readers import FUZZ
+from foldcore.result_file import MAX_FRAME_COORDINATE_MM, MAX_TITLE_CHARS
+from test_fuzz_readers import FUZZ, _json_bytes, fold_mutation
+from test_fuzz_results import frame_mutation
 from test_view import chromium
 
 pytestmark = pytest.mark.filterwarnings("ignore::foldcore.errors.PatternWarning")
@@ -248,3 +254,79 @@ def hostile_results(draw, base: dict) -> tuple[str, dict]:
 def test_hostile_result_files_are_refused_in_one_line(series, tmp_path_factory, capsys, data):
     what, d = data.draw(hostile_results(series))
     assert_refused(d, tmp_path_factory.mktemp("h"), capsys, what)
+
+
+def page_data(page) -> dict:
+    """The data block of a view page, checked to be inert JSON: no ``<`` in it, so it
+    cannot end its ``<script>`` element."""
+    text = page.read_text()
+    start = text.index(DATA_OPEN) + len(DATA_OPEN)
+    block = text[start:text.index("</script>", start)]
+    assert "<" not in block and "\u2028" not in block and "\u2029" not in block
+    return json.loads(block)
+
+
+DATA_OPEN = '<script type="application/json" id="data">'
+
+
+def assert_sound_page(page) -> None:
+    """What a page shows is in range: titles short text, positions and strains finite
+    float32 within the coordinate bound, angles null or within ±180°."""
+    for frame in page_data(page)["frames"]:
+        assert isinstance(frame["title"], str) and len(frame["title"]) <= MAX_TITLE_CHARS
+        xyz = np.frombuffer(base64.b64decode(frame["xyz"]), "<f4")
+        assert len(xyz) and (np.abs(xyz) <= MAX_FRAME_COORDINATE_MM).all()
+        assert np.isfinite(np.frombuffer(base64.b64decode(frame["strain"]), "<f4")).all()
+        assert all(a is None or abs(a) <= 180.0 for a in frame["angles"])
+
+
+@st.composite
+def corrupted_series(draw, bases: list) -> dict:
+    """A result file corrupted as in ``tests/test_fuzz_results.py``, one to three
+    times, each time in the key frame, the last folded frame or an earlier one."""
+    d = copy.deepcopy(draw(st.sampled_from(bases)))
+    for _ in range(draw(st.integers(1, 3))):
+        frames = d.get("file_frames")
+        where = draw(st.sampled_from(["key", "last", "earlier"]))
+        if where == "key":
+            draw(fold_mutation(d))
+        elif where == "earlier" and isinstance(frames, list) and len(frames) > 1:
+            k = draw(st.integers(0, len(frames) - 2))
+            frames.append(frames.pop(k))   # frame_mutation changes the last frame
+            draw(frame_mutation(d))
+            if d.get("file_frames") is frames and len(frames) > k:
+                frames.insert(k, frames.pop())
+        else:
+            draw(frame_mutation(d))
+    return d
+
+
+@FUZZ
+@given(data=st.data())
+def test_corrupted_results_give_a_sound_page_or_one_line(series, tmp_path_factory, capsys,
+                                                         data):
+    """Any outcome but a page whose values are in range or a one-line refusal without a
+    page is a bug (an exception escaping ``main`` fails the test as it is)."""
+    d = data.draw(corrupted_series([series, _single_frame(series)]))
+    folder = tmp_path_factory.mktemp("c")
+    source, page = folder / "corrupted.fold", folder / "view.html"
+    source.write_bytes(_json_bytes(d) or b"{}")
+    code = main(["view", str(source), "-o", str(page)])
+    err = capsys.readouterr().err
+    event("page" if code == 0 else "refused")
+    if code == 0:
+        assert page.exists() and "foldcore: error" not in err, err
+        assert_sound_page(page)
+    else:
+        assert code == 2 and err.count("\n") == 1, err
+        assert err.startswith(f"foldcore: error: {source}: ") and not page.exists(), err
+
+
+def _single_frame(series: dict) -> dict:
+    """The series as a ``simulate -o`` result: its last frame only, without per-frame
+    angles (the key frame's ``edges_foldAngle`` are shown)."""
+    d = copy.deepcopy(series)
+    frame = d["file_frames"][-1]
+    frame.pop("foldcore:pattern_foldAngle")
+    d["file_frames"] = [frame]
+    return d
