@@ -593,6 +593,106 @@ def test_fuzz_files(fuzz_dir, case, explicit):
     outcome(lambda: fio.read(path, **kw), path, hinge_path)
 
 
+# --------------------------------------------------------------------- svg
+_SVG_NUMBERS = ["0", "50", "100", "-3.5", "1e308", "-1e308", "1e309", "nan", "inf", "-inf",
+                "", "2em", "50%", "3mm", "1e-320", "0x10", "١٢", "5 5", "--1", ".5e"]
+_SVG_STROKES = ["#f00", "#00f", "#000", "#ff0", "#f0f", "#0f0", "red", "none", "rgb(0,0,300)",
+                "url(#x)", "#12345", ""]
+_SVG_TRANSFORMS = ["scale({})", "translate({},{})", "rotate({})", "rotate({} 50 50)",
+                   "matrix({},0,0,{},0,0)", "skewX({})", "scale({}) rotate(30)"]
+
+
+@st.composite
+def svg_shapes(draw, depth: int = 0) -> str:
+    """One element: a stroked shape with numbers from the extremes, or a group of them
+    (some transformed, some nested)."""
+    number = st.sampled_from(_SVG_NUMBERS) | st.floats(-1e3, 1e3).map(repr)
+    kind = draw(st.sampled_from(["line", "rect", "polyline", "path", "g", "text", "circle"]
+                                if depth < 3 else ["line", "rect"]))
+    attrs = {"stroke": draw(st.sampled_from(_SVG_STROKES)), "fill": "none"}
+    if draw(st.booleans()):
+        attrs[draw(st.sampled_from(["opacity", "stroke-opacity"]))] = draw(number)
+    if draw(st.integers(0, 3)) == 0:
+        form = draw(st.sampled_from(_SVG_TRANSFORMS))
+        attrs["transform"] = form.format(*[draw(number) for _ in range(form.count("{}"))])
+    if kind == "g":
+        body = "".join(draw(st.lists(svg_shapes(depth + 1), max_size=3)))
+    else:
+        keys = {"line": ["x1", "y1", "x2", "y2"], "rect": ["x", "y", "width", "height"],
+                "circle": ["cx", "cy", "r"], "text": ["x", "y"]}.get(kind, [])
+        attrs.update({k: draw(number) for k in keys})
+        if kind == "polyline":
+            attrs["points"] = " ".join(f"{draw(number)},{draw(number)}"
+                                       for _ in range(draw(st.integers(0, 4))))
+        if kind == "path":
+            attrs["d"] = "M" + " L".join(f"{draw(number)} {draw(number)}"
+                                         for _ in range(draw(st.integers(1, 4))))
+        body = "x" if kind == "text" else ""
+    text = " ".join(f'{k}="{v}"' for k, v in attrs.items())
+    return f"<{kind} {text}>{body}</{kind}>"
+
+
+_SVG_OPENINGS = ['<svg xmlns="http://www.w3.org/2000/svg" width="100px" height="100px" '
+                 'viewBox="0 0 100 100">', '<svg xmlns="http://www.w3.org/2000/svg">',
+                 '<svg xmlns="http://www.w3.org/2000/svg" width="2em" height="1e309" '
+                 'viewBox="0 0 nan 100">', '<svg width="100" height="100">',
+                 '<html xmlns="http://www.w3.org/2000/svg">']
+_SQUARE = '<rect x="0" y="0" width="100" height="100" fill="none" stroke="#000"/>'
+
+
+@st.composite
+def svg_documents(draw) -> bytes:
+    """A drawing of the square sheet plus generated shapes, sometimes wrapped in
+    deep groups, entity declarations or a long comment, sometimes cut short."""
+    opening = draw(st.sampled_from(_SVG_OPENINGS))
+    closing = "</html>" if opening.startswith("<html") else "</svg>"
+    body = _SQUARE + "".join(draw(st.lists(svg_shapes(), max_size=6)))
+    wrap = draw(st.integers(0, 9))
+    if wrap == 0:
+        body = "<g>" * 120 + body + "</g>" * 120
+    elif wrap == 1:
+        opening = '<!DOCTYPE svg [<!ENTITY a "aaaaaaaaaa"><!ENTITY b "&a;&a;&a;&a;">]>' \
+            + opening
+        body += "<desc>&b;</desc>"
+    elif wrap == 2:
+        body += "<!--" + "-" * draw(st.integers(0, 3)) + "x" * 10_000 + "-->"
+    text = (opening + body + closing).encode()
+    if draw(st.integers(0, 5)) == 0:
+        text = text[:draw(st.integers(0, len(text)))]
+    return text
+
+
+@FUZZ
+@given(blob=svg_documents())
+def test_fuzz_svg(fuzz_dir, blob):
+    """Generated drawings through :func:`foldcore.io.read`: a valid pattern or one
+    line naming the file."""
+    path = os.path.join(fuzz_dir, "p.svg")
+    with open(path, "wb") as fh:
+        fh.write(blob)
+    outcome(lambda: fio.read(path), path)
+
+
+_REAL_SVG = sorted(p for p in os.listdir("tests/data/real") if p.endswith(".svg"))
+
+
+@FUZZ
+@given(name=st.sampled_from(_REAL_SVG), cuts=st.lists(
+    st.tuples(st.floats(0, 1), st.integers(0, 40), st.binary(max_size=12)), max_size=4))
+def test_fuzz_svg_mutated_real_files(fuzz_dir, name, cuts):
+    """Real drawings (Origami Simulator's among them) with bytes deleted and inserted
+    at random places."""
+    with open(os.path.join("tests/data/real", name), "rb") as fh:
+        blob = bytearray(fh.read())
+    for where, length, insert in cuts:
+        at = int(where * len(blob))
+        blob[at:at + length] = insert
+    path = os.path.join(fuzz_dir, "m.svg")
+    with open(path, "wb") as fh:
+        fh.write(bytes(blob))
+    outcome(lambda: fio.read(path), path)
+
+
 # -------------------------------------------------------- plain regressions
 @pytest.mark.parametrize("path", ["bad\0name.fold", "bad\0name.obj", "bad\0name.stl"])
 def test_nul_in_path_refused(path):

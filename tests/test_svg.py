@@ -127,3 +127,76 @@ def test_a_t_join_next_to_a_crossing_is_not_an_overlap(tmp_path):
     assert crease_set(pattern) == {("M", -180.0): 2, ("V", 180.0): 1}
     crane = read(REAL + "traditionalCrane.svg")
     assert (crane.assignments == "M").any() and (crane.assignments == "V").any()
+
+
+CREASE = '<line x1="50" y1="0" x2="50" y2="100" stroke="#f00"/>'
+
+
+@pytest.mark.parametrize("text, needles", [
+    ('<html xmlns="http://www.w3.org/2000/svg"><body>' + SQUARE + CREASE + '</body></html>',
+     ["root element is <html>"]),
+    (svg(SQUARE + '<line x1="-1e308" y1="0" x2="50" y2="100" stroke="#f00"/>'),
+     ["line 1", "outside the accepted"]),
+    (svg(SQUARE + '<g transform="translate(1e308)">' + CREASE + '</g>'),
+     ["line 1", "outside the accepted"]),
+    (svg(SQUARE + '<line x1="1e309" y1="0" x2="50" y2="100" stroke="#f00"/>'),
+     ["line 1", "x1='1e309'", "not a finite number"]),
+    (svg(SQUARE + '<line x1="nan" y1="0" x2="50" y2="100" stroke="#f00"/>'),
+     ["line 1", "x1='nan'"]),
+    (svg(SQUARE + '<polyline points="50,0 nan,100" stroke="#f00" fill="none"/>'),
+     ["polyline 1", "'nan'"]),
+    (svg(SQUARE + '<line x1="50" y1="0" x2="50" y2="100" stroke="#f00" opacity="nan"/>'),
+     ["line 1", "opacity=nan"]),
+    (svg(SQUARE + '<g transform="scale(0)">' + CREASE + '</g>'),
+     ["line 1", "singular"]),
+    (svg(SQUARE + '<g>' * 150 + CREASE + '</g>' * 150), ["nested more than 100 deep"]),
+    ('<?xml version="1.0"?><!DOCTYPE svg [<!ENTITY a "aaaa"><!ENTITY b "&a;&a;&a;">]>'
+     + svg(SQUARE + CREASE + '<desc>&b;</desc>'), ["entities"]),
+    ('<?xml version="1.0"?><!DOCTYPE svg [<!ENTITY x SYSTEM "file:///etc/passwd">]>'
+     + svg(SQUARE + CREASE + '<desc>&x;</desc>'), ["entities"]),
+    ('<svg xmlns="http://www.w3.org/2000/svg" width="2em" height="100px" '
+     'viewBox="0 0 100 100">' + SQUARE + CREASE + '</svg>', ["not a readable SVG"]),
+])
+def test_hostile_drawings_are_refused_in_one_line_naming_the_element(tmp_path, text, needles):
+    """Numbers outside the arithmetic's range, values svgelements would read as 0, a
+    singular transform (its crease would vanish), deep nesting and entities: each is
+    one line naming the file and what is wrong, nothing read silently otherwise."""
+    with pytest.raises(PatternError) as info:
+        read_text(tmp_path, text)
+    message = str(info.value)
+    assert "p.svg" in message and "\n" not in message
+    for needle in needles:
+        assert needle in message, message
+
+
+def test_many_lines_through_one_place_are_refused_before_the_work(tmp_path):
+    """400 lines through the sheet's centre meet 80 000 times at one place: counted
+    before noding (which took minutes and gigabytes) and refused."""
+    lines = "".join(f'<line x1="{i / 4}" y1="0" x2="{100 - i / 4}" y2="100" stroke="#f00"/>'
+                    for i in range(400))
+    with pytest.raises(PatternError, match="too many lines through one place|meet or cross"):
+        read_text(tmp_path, svg(SQUARE + lines))
+
+
+def test_a_comment_is_skipped_in_time_linear_in_its_size(tmp_path):
+    """A 4 MB comment (svgelements' own parse of comments grows faster than their
+    size): screened out before it, so the pattern reads as without it."""
+    plain, _ = read_text(tmp_path, svg(SQUARE + CREASE))
+    commented, _ = read_text(tmp_path, svg(SQUARE + CREASE + "<!--" + "x" * 4_000_000 + "-->"))
+    assert crease_set(commented) == crease_set(plain) == {("M", -180.0): 1}
+
+
+def test_a_rotated_rect_is_read_rotated(tmp_path):
+    """A rect's transform that rotates it is applied (a rect cannot take it into its
+    own x, y, width, height): the square 40 … 60 px turned by 45° about its centre
+    has its corners on the axes through the centre, 10√2 px from it."""
+    from foldcore.io.svg import _strokes
+
+    path = tmp_path / "p.svg"
+    path.write_text(svg('<rect x="40" y="40" width="20" height="20" fill="none" '
+                        'stroke="#00f" transform="rotate(45 50 50)"/>'))
+    segments, kinds, _, _ = _strokes(str(path))
+    corners = segments[:, 0] - 50.0
+    assert len(segments) == 4 and set(kinds) == {"V"}
+    np.testing.assert_allclose(np.abs(corners).max(axis=1), 10 * 2 ** 0.5, rtol=1e-12)
+    np.testing.assert_allclose(np.abs(corners).min(axis=1), 0.0, atol=1e-9)

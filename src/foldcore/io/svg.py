@@ -37,13 +37,16 @@ pattern seen from +z is the drawing as seen on screen, its top side up.
 """
 from __future__ import annotations
 
+import io
 import os
+import re
 
 import numpy as np
 
 from ..errors import PatternError
 from ..pattern import CreasePattern
 from .conventions import Reading, note
+from .svg_screen import screened_svg
 
 MM_PER_PX = 25.4 / 96.0  # CSS pixel
 #: Merge distance, px: Origami Simulator's ``vertTol`` (its published patterns rely
@@ -60,6 +63,26 @@ PARALLEL = 0.1
 #: Stroke (r, g, b) → (assignment, sign of the target: -1 mountain, +1 valley, 0 none).
 STROKES = {(0, 0, 0): ("B", 0.0), (255, 0, 0): ("M", -1.0), (0, 0, 255): ("V", 1.0),
            (255, 255, 0): ("F", 0.0), (255, 0, 255): ("U", 0.0), (0, 255, 0): ("C", 0.0)}
+#: Largest coordinate accepted after transforms, px (264 km: beyond every length
+#: foldcore folds, far inside the arithmetic's range).
+MAX_COORD_PX = 1e9
+#: Most straight segments in one pattern ...
+MAX_SEGMENTS = 200_000
+#: ... and most pairs of them that meet or cross (each a vertex to node; Origami
+#: Simulator's library has at most 16 782, and noding 10⁵ takes about 2 s).
+MAX_MEETINGS = 100_000
+#: Most pairs of noded points closer than the merge distance (a few per T-join or
+#: crossing in a drawing; many lines through one point crowd there by the million).
+MAX_CLOSE_PAIRS = 1_000_000
+#: What svgelements raises on values it cannot compute (units it cannot resolve,
+#: degenerate transforms, numbers out of range): refused naming the element.
+_NUMBER = re.compile(r"([+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)")
+_LENGTH = re.compile(_NUMBER.pattern + r"\s*(?:px|mm|cm|in|pt|pc|em|ex|%)?")
+_SEPARATORS = re.compile(r"[\s,]+")
+#: Attributes that place a shape's points.
+_GEOMETRY = ("x", "y", "x1", "y1", "x2", "y2", "width", "height", "cx", "cy", "r", "rx", "ry")
+_SVG_FAILURES = (ArithmeticError, ValueError, TypeError, IndexError, AttributeError,
+                 KeyError)
 
 
 def read_svg(path, reading: Reading | None = None) -> CreasePattern:
@@ -78,10 +101,11 @@ def read_svg(path, reading: Reading | None = None) -> CreasePattern:
         raise PatternError(f"{source}: no stroked lines in Origami Simulator's colours "
                            "(red mountain, blue valley, black boundary, yellow facet, "
                            "magenta undriven)")
+    _check_meetings(segments, source)
     segments[:, :, 1] *= -1.0  # SVG y points down
     extent = float(np.ptp(segments.reshape(-1, 2), axis=0).max())
     tol = min(SNAP_PX, SNAP_MAX * extent)
-    vertices, edges, pieces = _planarise(segments, tol)
+    vertices, edges, pieces = _planarise(segments, tol, source)
     assignments, fold_angles = _piece_types(pieces, edges, vertices, segments, kinds,
                                             angles, owners, tol, source)
     factor = reading.factor(extent * MM_PER_PX) * MM_PER_PX
@@ -92,18 +116,8 @@ def read_svg(path, reading: Reading | None = None) -> CreasePattern:
 def _strokes(source: str):
     """(S, 2, 2) straight segments (px), their assignment, target (degrees or NaN) and
     the element each came from (for messages)."""
-    try:
-        from svgelements import SVG, Close, Line, Move, Path, Shape
-    except ImportError as exc:  # pragma: no cover - a dependency
-        raise PatternError(f"{source}: reading SVG needs svgelements "
-                           "(pip install svgelements)") from exc
-    try:
-        svg = SVG.parse(source, reify=True)
-    except Exception as exc:  # not XML, not SVG: one line naming the file
-        raise PatternError(f"{source}: not a readable SVG ({type(exc).__name__}: "
-                           f"{' '.join(str(exc).split())[:120]})") from None
     segments, kinds, angles, owners, ignored = [], [], [], [], {}
-    for number, element in enumerate(e for e in svg.elements() if isinstance(e, Shape)):
+    for number, element in enumerate(_shapes(source)):
         name = _element_name(element, number)
         kind, sign = _stroke_type(element)
         if kind is None:
@@ -115,25 +129,131 @@ def _strokes(source: str):
             raise PatternError(f"{source}: {name} is a cut (green stroke); foldcore does "
                                "not cut sheets: draw the cut as boundary (black) around "
                                "separate pieces, or remove it")
-        angle = sign * 180.0 * _opacity(element) if sign else (0.0 if kind == "F" else np.nan)
-        for seg in Path(element):
-            if isinstance(seg, Move) or seg.start is None or seg.end is None:
-                continue
-            if not isinstance(seg, (Line, Close)):
-                _check_straight(seg, name, source)
-            a, b = (float(seg.start.x), float(seg.start.y)), (float(seg.end.x),
-                                                              float(seg.end.y))
-            if a != b:
-                segments.append((a, b))
-                kinds.append(kind)
-                angles.append(angle)
-                owners.append(name)
+        angle = sign * 180.0 * _opacity(element, name, source) if sign \
+            else (0.0 if kind == "F" else np.nan)
+        try:
+            found = _element_segments(element, name, source)
+        except PatternError:
+            raise
+        except _SVG_FAILURES as exc:
+            raise PatternError(f"{source}: {name} cannot be computed "
+                               f"({_failure(exc)})") from None
+        segments += found
+        kinds += [kind] * len(found)
+        angles += [angle] * len(found)
+        owners += [name] * len(found)
+        if len(segments) > MAX_SEGMENTS:
+            raise PatternError(f"{source}: more than {MAX_SEGMENTS} straight segments "
+                               f"(at {name})")
     if ignored:
         counts = ", ".join(f"{n} {c}" for c, n in sorted(ignored.items()))
         note(source, f"{sum(ignored.values())} shapes whose stroke is none of Origami "
                      f"Simulator's colours were ignored ({counts})")
     return (np.array(segments, dtype=np.float64).reshape(-1, 2, 2), np.array(kinds),
             np.array(angles, dtype=np.float64), owners)
+
+
+def _shapes(source: str) -> list:
+    """The drawing's shapes (svgelements, transforms and styles applied) from the
+    screened file (:func:`~.svg_screen.screened_svg`)."""
+    try:
+        from svgelements import SVG, Shape
+    except ImportError as exc:  # pragma: no cover - a dependency
+        raise PatternError(f"{source}: reading SVG needs svgelements "
+                           "(pip install svgelements)") from exc
+    data = screened_svg(source)
+    try:
+        svg = SVG.parse(io.BytesIO(data), reify=False)  # transforms checked per shape
+        return [e for e in svg.elements() if isinstance(e, Shape)]
+    except (*_SVG_FAILURES, RecursionError) as exc:
+        raise PatternError(f"{source}: not a readable SVG ({_failure(exc)})") from None
+
+
+def _element_segments(element, name: str, source: str) -> list:
+    """[((x0, y0), (x1, y1))] the straight segments (px) of one stroked shape, its
+    transform applied; refused naming the element where a geometric attribute is
+    not a finite number (svgelements would read it as 0) or the transform is
+    singular or not finite (a ``scale(0)`` would make its creases vanish)."""
+    from svgelements import Close, Line, Move, Path
+
+    _check_geometry(element, name, source)
+    matrix = element.transform
+    entries = [matrix.a, matrix.b, matrix.c, matrix.d, matrix.e, matrix.f]
+    if not (all(np.isfinite(entries)) and matrix.determinant != 0.0):
+        raise PatternError(f"{source}: {name} has a transform that is singular or not "
+                           f"finite ({', '.join(f'{v:g}' for v in entries)}); its "
+                           "creases would vanish or leave the sheet")
+    path = Path(element)
+    path.reify()
+    out = []
+    for seg in path:
+        if isinstance(seg, Move) or seg.start is None or seg.end is None:
+            continue
+        if not isinstance(seg, (Line, Close)):
+            _check_straight(seg, name, source)
+        a = _point(seg.start, name, source)
+        b = _point(seg.end, name, source)
+        if a != b:
+            out.append((a, b))
+    return out
+
+
+def _check_geometry(element, name: str, source: str) -> None:
+    """Each geometric attribute as written (``x1``, ``width``, ``points`` …) is finite
+    numbers (with a unit where one may stand): svgelements reads what is not as 0,
+    which would move the crease."""
+    for key in _GEOMETRY:
+        raw = element.values.get(key)
+        if raw is not None and not _finite_length(str(raw)):
+            raise PatternError(f"{source}: {name} has {key}={str(raw)[:40]!r}, not a "
+                               "finite number")
+    points = element.values.get("points")
+    if points is not None:
+        tokens = _SEPARATORS.split(str(points).strip())
+        bad = [t for t in tokens if t and not _finite_length(t, unit=False)]
+        if bad:
+            raise PatternError(f"{source}: {name} has points with {bad[0][:40]!r}, not a "
+                               "finite number")
+
+
+def _finite_length(text: str, unit: bool = True) -> bool:
+    """Whether ``text`` is one finite SVG number (followed by a unit where ``unit``)."""
+    match = (_LENGTH if unit else _NUMBER).fullmatch(text.strip())
+    return bool(match) and np.isfinite(float(match.group(1)))
+
+
+def _point(p, name: str, source: str) -> tuple:
+    """(x, y) px of a segment's end, refused naming the element unless finite and
+    within :data:`MAX_COORD_PX`."""
+    x, y = float(p.x), float(p.y)
+    if not (abs(x) <= MAX_COORD_PX and abs(y) <= MAX_COORD_PX):  # False for NaN too
+        raise PatternError(f"{source}: {name} has a point at ({x:g}, {y:g}) px after its "
+                           f"transforms, outside the accepted ±{MAX_COORD_PX:g} px")
+    return x, y
+
+
+def _failure(exc: BaseException) -> str:
+    """An exception as a short one-line text."""
+    return f"{type(exc).__name__}: {' '.join(str(exc).split())[:120]}"
+
+
+def _check_meetings(segments: np.ndarray, source: str) -> None:
+    """Refuse a drawing whose segments meet or cross more than :data:`MAX_MEETINGS`
+    times (each meeting a vertex the noding creates; counted in chunks so that the
+    count stops once past the bound)."""
+    import shapely
+
+    lines = shapely.linestrings(segments)
+    tree = shapely.STRtree(lines)
+    chunk = max(64, 2_000_000 // max(len(lines), 1))
+    total = 0
+    for start in range(0, len(lines), chunk):
+        first, second = tree.query(lines[start:start + chunk], predicate="intersects")
+        total += int(np.count_nonzero(first + start < second))
+        if total > MAX_MEETINGS:
+            raise PatternError(f"{source}: its {len(lines)} segments meet or cross more "
+                               f"than {MAX_MEETINGS} times; foldcore reads crease "
+                               "patterns, not hatchings")
 
 
 def _element_name(element, number: int) -> str:
@@ -149,15 +269,21 @@ def _stroke_type(element):
     return STROKES.get((stroke.red, stroke.green, stroke.blue), (None, 0.0))
 
 
-def _opacity(element) -> float:
+def _opacity(element, name: str, source: str) -> float:
     """``opacity`` × ``stroke-opacity`` of the element (each 1 when absent), in [0, 1]:
     as written (svgelements keeps stroke-opacity as the colour's 8-bit alpha, which
-    would turn 0.25 into 45.18°), else the colour's alpha."""
+    would turn 0.25 into 45.18°), else the colour's alpha. Values outside [0, 1] are
+    clamped (CSS); a value that is not a number is ignored (CSS), one that is not
+    finite refused naming the element (it would drop the crease's target)."""
     def number(key, default):
         try:
-            return float(element.values.get(key, default))
+            value = float(element.values.get(key, default))
         except (TypeError, ValueError):
             return default
+        if not np.isfinite(value):
+            raise PatternError(f"{source}: {name} has {key}={value}, not a finite number "
+                               "(the opacity is the crease's target angle / 180°)")
+        return value
     stroke = number("stroke-opacity", element.stroke.opacity)
     return float(np.clip(number("opacity", 1.0) * stroke, 0.0, 1.0))
 
@@ -171,8 +297,8 @@ def _check_straight(seg, name: str, source: str) -> None:
     length = float(np.hypot(*chord))
     for t in (0.25, 0.5, 0.75):
         p = seg.point(t)
-        off = abs(float(np.cross(chord, np.array([p.x, p.y], dtype=float) - a))) / max(length,
-                                                                                      1e-300)
+        d = np.array([p.x, p.y], dtype=float) - a
+        off = abs(float(chord[0] * d[1] - chord[1] * d[0])) / max(length, 1e-300)
         if off > STRAIGHT * length:
             raise PatternError(f"{source}: {name} has a curved segment "
                                f"({type(seg).__name__} from ({a[0]:g}, {a[1]:g}) to "
@@ -180,7 +306,7 @@ def _check_straight(seg, name: str, source: str) -> None:
                                "draw creases as straight lines")
 
 
-def _planarise(segments: np.ndarray, tol: float):
+def _planarise(segments: np.ndarray, tol: float, source: str = "<segments>"):
     """(V, 2) vertices, (E, 2) edges and the (E, 2, 2) noded pieces of the segments:
     endpoints snapped onto nearby segments, near coordinates merged, crossings and
     overlaps noded (shapely's unary union)."""
@@ -194,7 +320,7 @@ def _planarise(segments: np.ndarray, tol: float):
         xy = shapely.get_coordinates(part)
         pieces.extend(zip(xy[:-1], xy[1:]))
     pieces = np.array(pieces, dtype=np.float64).reshape(-1, 2, 2)
-    vertices, ids = _merge_close(pieces.reshape(-1, 2), tol)
+    vertices, ids = _merge_close(pieces.reshape(-1, 2), tol, source)
     edges = np.sort(ids.reshape(-1, 2), axis=1)
     keep = edges[:, 0] != edges[:, 1]  # a piece shorter than tol: its ends merged
     edges, first = np.unique(edges[keep], axis=0, return_index=True)
@@ -202,19 +328,26 @@ def _planarise(segments: np.ndarray, tol: float):
     return vertices[used], edges.reshape(-1, 2), pieces[keep][first]
 
 
-def _merge_close(points: np.ndarray, tol: float):
+def _merge_close(points: np.ndarray, tol: float, source: str):
     """(V, 2) points with every cluster closer than ``tol`` (transitively) replaced by
     its mean, and each input point's id (several crossings rounded apart at one
-    vertex, a T-join's ends)."""
-    from scipy.cluster.hierarchy import DisjointSet
+    vertex, a T-join's ends); refused where more than :data:`MAX_CLOSE_PAIRS` pairs
+    are that close (counted before they are listed)."""
+    import scipy.sparse as sp
+    from scipy.sparse.csgraph import connected_components
     from scipy.spatial import cKDTree
 
     unique, ids = np.unique(points, axis=0, return_inverse=True)
-    clusters = DisjointSet(range(len(unique)))
-    for i, j in cKDTree(unique).query_pairs(tol):
-        clusters.merge(i, j)
-    roots = np.array([clusters[i] for i in range(len(unique))])
-    _, cluster = np.unique(roots, return_inverse=True)
+    tree = cKDTree(unique)
+    close = (int(tree.count_neighbors(tree, tol)) - len(unique)) // 2
+    if close > MAX_CLOSE_PAIRS:
+        raise PatternError(f"{source}: {close} pairs of its crossings lie within the "
+                           f"merge distance {tol:g} px of each other (more than "
+                           f"{MAX_CLOSE_PAIRS}): too many lines through one place")
+    pairs = tree.query_pairs(tol, output_type="ndarray")
+    graph = sp.coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])),
+                          shape=(len(unique), len(unique)))
+    _, cluster = connected_components(graph, directed=False)
     merged = np.zeros((cluster.max() + 1 if len(cluster) else 0, 2))
     np.add.at(merged, cluster, unique)
     merged /= np.bincount(cluster)[:, None]
