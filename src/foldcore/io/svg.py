@@ -165,7 +165,7 @@ def _shapes(source: str) -> list:
     try:
         svg = SVG.parse(io.BytesIO(data), reify=False)  # transforms checked per shape
         return [e for e in svg.elements() if isinstance(e, Shape)]
-    except (*_SVG_FAILURES, RecursionError) as exc:
+    except (*_SVG_FAILURES, RecursionError, SyntaxError) as exc:  # ParseError: SyntaxError
         raise PatternError(f"{source}: not a readable SVG ({_failure(exc)})") from None
 
 
@@ -189,10 +189,10 @@ def _element_segments(element, name: str, source: str) -> list:
     for seg in path:
         if isinstance(seg, Move) or seg.start is None or seg.end is None:
             continue
-        if not isinstance(seg, (Line, Close)):
-            _check_straight(seg, name, source)
         a = _point(seg.start, name, source)
         b = _point(seg.end, name, source)
+        if not isinstance(seg, (Line, Close)):
+            _check_straight(seg, name, source)
         if a != b:
             out.append((a, b))
     return out
@@ -296,8 +296,7 @@ def _check_straight(seg, name: str, source: str) -> None:
     chord = b - a
     length = float(np.hypot(*chord))
     for t in (0.25, 0.5, 0.75):
-        p = seg.point(t)
-        d = np.array([p.x, p.y], dtype=float) - a
+        d = np.array(_point(seg.point(t), name, source)) - a
         off = abs(float(chord[0] * d[1] - chord[1] * d[0])) / max(length, 1e-300)
         if off > STRAIGHT * length:
             raise PatternError(f"{source}: {name} has a curved segment "

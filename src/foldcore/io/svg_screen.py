@@ -5,8 +5,8 @@ The XML is parsed once with defusedxml (entity declarations, external entities a
 DTD tricks refused) and written back without its comments, processing instructions
 and document type: the SVG reader (svgelements) then sees only elements and their
 attributes, in time linear in the file's size. The bounds sit far above Origami
-Simulator's library (84 patterns; the largest is 0.7 MB with about 7 000 elements
-nested 4 deep): a file past them is refused in one line before any work.
+Simulator's library (84 patterns: at most 0.7 MB, 5 011 elements, nested 7
+deep): a file past them is refused in one line before any work.
 """
 from __future__ import annotations
 
@@ -54,7 +54,8 @@ def screened_svg(path) -> bytes:
         raise PatternError(f"{source}: the root element is <{_local_name(root.tag)}>, "
                            "not <svg>")
     _check_tree(root, source)
-    return ET.tostring(root)
+    return ET.tostring(root, encoding="utf-8")  # names as written (ASCII would
+    #                                               turn À in a name into &#192;)
 
 
 def _check_tree(root, source: str) -> None:
