@@ -915,3 +915,22 @@ def test_a_huge_bad_line_gives_a_short_message():
     with pytest.raises(PatternError) as err:
         parse_obj("v 0 0\nv 1 0\nv 0 1\nf 1 2 " + "x" * 100_000 + "\n", "big.obj")
     assert "big.obj, line 4" in str(err.value) and len(str(err.value)) < 300
+
+
+def test_a_large_file_packed_with_empty_lists_is_refused_before_parsing(tmp_path):
+    """``[],`` repeated needs about 25 × its size in memory as Python lists; a file
+    over 1 MiB with more than one array or object per 6 bytes is refused unparsed,
+    while the same size of FOLD rows (``[1,2],``: 6 bytes each) reads."""
+    from foldcore.io.fold_json import BYTES_PER_CONTAINER, DENSE_FROM_BYTES
+
+    head = ('{"vertices_coords":[[0,0],[1,0],[0,1]],"faces_vertices":[[0,1,2]],'
+            '"edges_vertices":[[0,1],[1,2],[2,0]],"edges_assignment":["B","B","B"],"x":[')
+    rows = DENSE_FROM_BYTES // 3 + 10
+    dense = tmp_path / "dense.fold"
+    dense.write_text(head + "[]," * rows + "[]]}")
+    with pytest.raises(PatternError, match=r"dense.fold: \d+ JSON arrays and objects"):
+        fio.read(dense)
+    sparse = tmp_path / "rows.fold"
+    sparse.write_text(head + "[1,2]," * (DENSE_FROM_BYTES // BYTES_PER_CONTAINER + 10)
+                      + "[1,2]]}")
+    assert len(fio.read(sparse).vertices) == 3

@@ -39,6 +39,7 @@ _DIGITS_TO_ZERO = bytes.maketrans(b"123456789E", b"000000000e")
 def parse_json(data: bytes, source: str):
     """The JSON value of a FOLD file's bytes (UTF-8, optional BOM); PatternError naming
     ``source`` for bad text, bad JSON, NaN/Infinity or a number beyond float64."""
+    _check_density(data, source)
     try:
         text = data.decode("utf-8-sig")
     except UnicodeDecodeError as exc:
@@ -56,6 +57,27 @@ def parse_json(data: bytes, source: str):
         fail(source, f"not valid JSON: {exc.msg} at line {exc.lineno}, column {exc.colno}")
     except (ValueError, RecursionError) as exc:
         fail(source, f"not valid JSON ({type(exc).__name__}: {exc})")
+
+
+#: Files larger than this (bytes) must have at least ``BYTES_PER_CONTAINER`` bytes
+#: per JSON array or object: each costs Python about 64 bytes, so ``[],`` repeated
+#: would need 25 × the file's size to parse. A FOLD file's rows take 6 bytes
+#: (``[1,2],``) and more (a 10⁶-vertex grid: 26); with that, a parse needs at most
+#: about 15 × the file's size.
+DENSE_FROM_BYTES = 1024 * 1024
+BYTES_PER_CONTAINER = 6
+
+
+def _check_density(data: bytes, source: str) -> None:
+    """Refuse a large file packed with more JSON arrays and objects than any FOLD
+    file has (counted on the bytes, before any is built)."""
+    if len(data) <= DENSE_FROM_BYTES:
+        return
+    containers = data.count(b"[") + data.count(b"{")
+    if containers * BYTES_PER_CONTAINER > len(data):
+        fail(source, f"{containers} JSON arrays and objects in {len(data)} bytes, more than "
+                     f"one per {BYTES_PER_CONTAINER} bytes: no FOLD file is that dense, and "
+                     "reading it would take over 20 times its size in memory")
 
 
 def _may_overflow(data: bytes) -> bool:
