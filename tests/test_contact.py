@@ -256,3 +256,20 @@ def test_command_line_contact(tmp_path):
     assert report["settings"]["contact"] == "on"
     assert report["actuation"]["contact_blocked"] == [0]
     assert [c["stopped_by"] for c in report["actuation"]["creases"]] == ["contact", None]
+
+
+def test_contact_refuses_faces_split_into_cells(tmp_path):
+    """Contact's solids are whole rigid panels: with a face split into elastic cells,
+    neighbouring cells (and cells on both sides of a crease) would touch by
+    construction, which crashed ipctk's Hessian projection; refused in one line."""
+    from foldcore.cli import main
+    from foldcore.io import write_fold
+
+    pattern = patterns.single_hinge(panel_length=10.0, depth=5.0, angle=60.0, width=2.0)
+    mesh = thicken(pattern, H, elastic="facets", cell_size=1.0)
+    with pytest.raises(SimulationError, match="one rigid panel per face"):
+        Simulation(mesh, pattern, contact=True)
+    path = tmp_path / "crease.fold"
+    write_fold(path, pattern, thickness=H)
+    assert main(["simulate", str(path), "--contact", "on", "--elastic-cells", "1"]) == 2
+    assert main(["simulate", str(path), "--elastic-cells", "1"]) == 0

@@ -448,8 +448,9 @@ def contact_model(model, strategy, contact, obstacles=()):
                               f"contact needs one of {supported}")
     if not model.mesh.thickness > 0:
         raise SimulationError("contact needs a sheet of thickness > 0")
-    if model.mesh.panel_group != "rigid_panel":
-        raise SimulationError("contact needs rigid panels (this mesh's are elastic cells)")
+    if model.mesh.panel_group != "rigid_panel" or _faces_split(model.mesh):
+        raise SimulationError("contact needs one rigid panel per face (this mesh's faces "
+                              "are elastic cells: drop the elastic cells or contact)")
     try:
         built = ContactModel(model.mesh, model.pattern, model.system.reference_weight,
                              settings, obstacles)
@@ -469,6 +470,14 @@ def contact_model(model, strategy, contact, obstacles=()):
 
 #: A position target "misses" beyond this share of the pattern's size (Result).
 TARGET_MISS = 1e-3
+
+
+def _faces_split(mesh) -> bool:
+    """Whether a face of the pattern is more than one panel element (an elastic
+    plate's cells): contact's solids are whole panels, and cells of one face, or
+    of two faces a crease joins, would touch by construction."""
+    source = np.asarray(mesh.groups[mesh.panel_group].source)
+    return len(np.unique(source)) < len(source)
 
 
 def position_target_entries(model, contact: dict | None) -> list | None:
