@@ -335,3 +335,24 @@ def _has(module: str) -> bool:
         return False
     return True
 
+
+
+def test_render_without_a_writable_home_prints_only_its_own_line(tmp_path):
+    """Without a writable home matplotlib (imported by pyvista) and Mesa each printed
+    lines about their caches; the render gives them a temporary folder / no cache,
+    so ``simulate --render`` prints its one summary line."""
+    from foldcore.io import write_fold
+
+    path = tmp_path / "crease.fold"
+    write_fold(path, patterns.single_hinge(panel_length=10.0, depth=5.0, angle=60.0,
+                                           width=2.0), thickness=1.0)
+    env = dict(os.environ, HOME="/proc/none", XDG_CONFIG_HOME="/proc/none",
+               XDG_CACHE_HOME="/proc/none")
+    env.pop("MPLCONFIGDIR", None)
+    run = subprocess.run([sys.executable, "-m", "foldcore", "simulate", str(path),
+                          "--render", str(tmp_path / "x.png")],
+                         capture_output=True, text=True, env=env, timeout=300)
+    assert run.returncode == 0, run.stderr
+    lines = [line for line in run.stderr.splitlines() if line.strip()]
+    assert len(lines) == 1 and lines[0].startswith("foldcore:"), run.stderr
+    assert (tmp_path / "x.png").stat().st_size > 0

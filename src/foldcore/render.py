@@ -510,12 +510,44 @@ def render_png(pattern, mesh, positions, path, size=(1024, 768), view="iso",
         r.save(path)
 
 
+def _caches_where_writable() -> None:
+    """Without a writable home (a read-only install, a service account) matplotlib
+    (which pyvista imports) and Mesa's OpenGL each print lines about their caches:
+    give matplotlib a temporary folder and turn Mesa's shader cache off there. A
+    folder the user set (``MPLCONFIGDIR``, ``MESA_SHADER_CACHE_DIR``) is kept."""
+    import tempfile
+
+    home = os.path.expanduser("~")
+    config = os.environ.get("XDG_CONFIG_HOME") or os.path.join(home, ".config")
+    cache = os.environ.get("XDG_CACHE_HOME") or os.path.join(home, ".cache")
+    if "MPLCONFIGDIR" not in os.environ and not _writable(config):
+        import atexit
+        import shutil
+
+        folder = tempfile.mkdtemp(prefix="foldcore-matplotlib-")
+        atexit.register(shutil.rmtree, folder, ignore_errors=True)
+        os.environ["MPLCONFIGDIR"] = folder
+    if "MESA_SHADER_CACHE_DIR" not in os.environ and not _writable(cache):
+        os.environ.setdefault("MESA_SHADER_CACHE_DISABLE", "true")
+
+
+def _writable(folder: str) -> bool:
+    """Whether ``folder`` exists or can be made, and can be written (made as the
+    library would make it anyway)."""
+    try:
+        os.makedirs(folder, exist_ok=True)
+    except OSError:
+        return False
+    return os.access(folder, os.W_OK | os.X_OK)
+
+
 def require_pyvista(offscreen: bool = True):
     """pyvista (RenderError naming the extra when missing); ``offscreen``: set up for
     offscreen rendering, EGL directly when there is no display."""
     if offscreen and not os.environ.get("DISPLAY"):
         # without this VTK first tries X, fails with a warning, then falls back to EGL
         os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
+    _caches_where_writable()
     try:
         import pyvista as pv
     except ImportError:
