@@ -172,6 +172,36 @@ def test_frame_unit_cm(tmp_path):
     assert got.frame_unit == "cm"
 
 
+@pytest.mark.parametrize("unit, mm", [("unit", 1.0), ("mm", 1.0), ("cm", 10.0), ("m", 1000.0),
+                                      ("in", 25.4), ("pt", 25.4 / 72.0), ("um", 1e-3),
+                                      ("nm", 1e-6)])
+def test_every_frame_unit_is_its_length_in_mm(tmp_path, unit, mm):
+    """Each unit's factor is its SI definition (an inch is 25.4 mm exactly, a point
+    1/72 inch): coordinates, widths and the thickness scale alike."""
+    p = two_squares(width=0.25)  # 2 × 1 mm; the file gives it in ``unit``
+    d = fold_json(p, frame_unit=unit, **{"foldcore:thickness": 0.1 / mm})
+    d["vertices_coords"] = (np.asarray(d["vertices_coords"]) / mm).tolist()
+    d["foldcore:edges_width"] = [None if w is None else w / mm
+                                 for w in d["foldcore:edges_width"]]
+    got = fio.read_fold_file(write_json(tmp_path / f"{unit}.fold", d))
+    np.testing.assert_allclose(got.pattern.vertices, p.vertices, rtol=1e-12, atol=1e-15)
+    assert got.pattern.widths[6] == pytest.approx(0.25, rel=1e-12)
+    assert got.thickness == pytest.approx(0.1, rel=1e-12)
+
+
+def test_a_3d_row_among_2d_ones_is_read_only_with_z_zero(tmp_path):
+    """A row [x, y, 0] among 2D rows is the point (x, y); [x, y, z ≠ 0] is refused
+    naming the vertex."""
+    p = two_squares()
+    d = fold_json(p)
+    d["vertices_coords"][3] = d["vertices_coords"][3][:2] + [0.0]
+    got = fio.read_fold_file(write_json(tmp_path / "flat.fold", d))
+    np.testing.assert_array_equal(got.pattern.vertices, p.vertices)
+    d["vertices_coords"][3] = d["vertices_coords"][3][:2] + [0.5]
+    with pytest.raises(PatternError, match="raised.fold.*vertex 3 has z = 0.5"):
+        fio.read_fold(write_json(tmp_path / "raised.fold", d))
+
+
 def test_unknown_unit_refused(tmp_path):
     path = write_json(tmp_path / "furlong.fold", fold_json(two_squares(), frame_unit="furlong"))
     with pytest.raises(PatternError, match='furlong.fold.*frame_unit "furlong"'):
