@@ -129,6 +129,32 @@ def test_ctrl_c_writes_the_last_iterate_marked_partial(hinge_file, tmp_path, cap
     assert np.isfinite(info.value.result.positions).all()
 
 
+def test_ctrl_c_while_the_finished_result_is_written_completes_it(hinge_file, tmp_path,
+                                                                  capsys, monkeypatch):
+    """A first Ctrl-C while a converged result's outputs are written (SIGINT sent from
+    inside the writer) lets them finish: the files are whole, not partial, and the
+    command says so and exits 130."""
+    import os
+    import signal
+
+    from foldcore import outputs
+
+    write = outputs.write_result
+
+    def interrupted_write(*args, **kwargs):
+        os.kill(os.getpid(), signal.SIGINT)
+        return write(*args, **kwargs)
+
+    monkeypatch.setattr(outputs, "write_result", interrupted_write)
+    out, report = tmp_path / "o.fold", tmp_path / "r.json"
+    code = cli.main(["simulate", str(hinge_file), "-o", str(out), "--report", str(report)])
+    assert code == cli.EXIT_SIGINT
+    (line,) = capsys.readouterr().err.splitlines()
+    assert "while the finished result was written" in line and str(out) in line
+    fold, rep = json.loads(out.read_text()), json.loads(report.read_text())
+    assert "foldcore:partial" not in fold and rep["converged"] is True
+
+
 def test_the_readme_snippet_renders(tmp_path, monkeypatch):
     """The README's library snippet runs as printed, and ``foldcore render`` accepts
     the result it writes (its old ``write_fold`` of achieved angles had no folded

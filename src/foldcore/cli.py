@@ -325,10 +325,15 @@ def simulate(args) -> int:
         done = fold(args.pattern, callback=progress, **option_groups(args))
     except Interrupted as stop:
         written = ", ".join(f"{in_flags(k)} {v}" for k, v in stop.written.items())
-        print(f"foldcore: interrupted (SIGINT) after {stop.result.iterations} iterations; "
-              + (f"the last iterate was written as a partial result ({written}; marked "
-                 "foldcore:partial)" if written else "no output was asked for"),
-              file=sys.stderr)
+        if stop.partial:
+            print(f"foldcore: interrupted (SIGINT) after {stop.result.iterations} iterations; "
+                  + (f"the last iterate was written as a partial result ({written}; marked "
+                     "foldcore:partial)" if written else "no output was asked for"),
+                  file=sys.stderr)
+        else:
+            print("foldcore: interrupted (SIGINT) while the finished result was written; "
+                  f"its outputs were completed first ({written or 'none asked for'})",
+                  file=sys.stderr)
         return EXIT_SIGINT
     finally:
         if progress is not None:

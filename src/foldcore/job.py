@@ -17,6 +17,7 @@ flags to them and adds only its messages and exit codes.
 from __future__ import annotations
 
 import warnings
+from contextlib import contextmanager
 from dataclasses import dataclass
 
 from .errors import RunWarning
@@ -26,11 +27,13 @@ from .options import OptionError
 class Interrupted(KeyboardInterrupt):
     """Ctrl-C during the run: the last iterate was written as a partial result
     (``foldcore:partial`` in the FOLD file, ``reason: "interrupted"`` in the
-    report) to ``written`` (``outputs.field`` → path); ``result`` is that iterate."""
+    report) to ``written`` (``outputs.field`` → path); ``result`` is that iterate.
+    ``partial`` False: the Ctrl-C came while a finished result was being written,
+    which was completed first."""
 
-    def __init__(self, result, written: dict):
+    def __init__(self, result, written: dict, partial: bool = True):
         super().__init__()
-        self.result, self.written = result, written
+        self.result, self.written, self.partial = result, written, partial
 
 
 @dataclass
@@ -138,14 +141,42 @@ def fold(path, *, hinges=None, reading=None, thickening=None, solving=None, outp
     for text in said:
         warnings.warn(text, RunWarning, stacklevel=3)
     settings = _settings(job, thickness, mesh, sim)
-    write_result(result, loaded.pattern, mesh, thickness, settings, fold=out.fold,
-                 report=out.report, png=out.render, partial=interrupted,
-                 series=out.series, sweep=sweep)
-    if interrupted:
-        written = {k: v for k, v in out.paths().items()
-                   if v and k in ("outputs.fold", "outputs.report", "outputs.render")}
-        raise Interrupted(result, written)
+    with interrupts_deferred() as late:
+        write_result(result, loaded.pattern, mesh, thickness, settings, fold=out.fold,
+                     report=out.report, png=out.render, partial=interrupted,
+                     series=out.series, sweep=sweep)
+    if interrupted or late:
+        written = {k: v for k, v in out.paths().items() if v and k in
+                   ("outputs.fold", "outputs.report", "outputs.render", "outputs.series")}
+        raise Interrupted(result, written, partial=interrupted)
     return Fold(loaded.pattern, mesh, sim, result, settings, summary)
+
+
+@contextmanager
+def interrupts_deferred():
+    """A block a first Ctrl-C does not break: the outputs of a result already
+    computed are written whole, then the interrupt is raised by the caller (the
+    yielded list is non-empty if one came). A second Ctrl-C breaks it (the files
+    being written are then removed, :func:`foldcore.files.all_or_nothing`).
+    Outside the main thread (no signal handlers there) the block runs as it is."""
+    import signal
+    import threading
+
+    received: list = []
+    if threading.current_thread() is not threading.main_thread():
+        yield received
+        return
+
+    def defer(signum, frame):
+        if received:
+            raise KeyboardInterrupt
+        received.append(signum)
+
+    previous = signal.signal(signal.SIGINT, defer)
+    try:
+        yield received
+    finally:
+        signal.signal(signal.SIGINT, previous)
 
 
 def _prepared(job: Job):
