@@ -295,3 +295,17 @@ def test_version_and_a_render_that_is_not_png(fold_file, tmp_path, capsys):
     (line,) = capsys.readouterr().err.splitlines()
     assert "--render" in line and ".png" in line
     assert sorted(p.name for p in tmp_path.iterdir()) == ["hinge.fold"]
+
+
+def test_running_out_of_memory_is_one_line(fold_file, capsys, monkeypatch):
+    """A MemoryError anywhere in a command is one line naming the input, exit 2, not
+    a traceback."""
+    import foldcore.io
+
+    def exhausted(*args, **kwargs):
+        raise MemoryError
+
+    monkeypatch.setattr(foldcore.io, "read_file", exhausted)
+    assert main(["simulate", str(fold_file)]) == 2
+    (line,) = capsys.readouterr().err.splitlines()
+    assert line.startswith(f"foldcore: error: {fold_file}: out of memory")

@@ -541,6 +541,10 @@ def main(argv=None) -> int:
     except OSError as exc:
         name = exc.filename or getattr(args, "pattern", None) or getattr(args, "result", "")
         print(f"foldcore: error: {name}: {exc.strerror or exc}", file=sys.stderr)
+    except MemoryError:
+        name = getattr(args, "pattern", None) or getattr(args, "result", "") or args.command
+        print(f"foldcore: error: {name}: out of memory (a smaller file, fewer cells or "
+              "sub-strips, or more memory)", file=sys.stderr)
     except KeyboardInterrupt:
         print("foldcore: interrupted (SIGINT); files not yet complete were not written",
               file=sys.stderr)
