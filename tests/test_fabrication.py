@@ -410,3 +410,17 @@ def test_export_checks_every_destination_before_writing(result_fold, tmp_path):
     assert main(["export", str(result_fold), "--svg", str(svg),
                  "--stl", str(tmp_path / "missing" / "x.stl")]) == 2
     assert not svg.exists()
+
+
+def test_a_pattern_given_for_a_result_is_asked_for_a_result_fold(tmp_path, capsys):
+    """``foldcore export pattern.svg``: not 'not valid JSON', but what to give."""
+    from foldcore.cli import main
+
+    svg = tmp_path / "p.svg"
+    svg.write_text('<svg xmlns="http://www.w3.org/2000/svg"/>')
+    for command in (["export", str(svg), "--stl", str(tmp_path / "x.stl")],
+                    ["view", str(svg), "-o", str(tmp_path / "x.html")]):
+        assert main(command) == 2
+        (line,) = capsys.readouterr().err.splitlines()
+        assert "not a result FOLD file" in line and "simulate PATTERN -o" in line, line
+    assert not (tmp_path / "x.stl").exists() and not (tmp_path / "x.html").exists()

@@ -154,7 +154,11 @@ def read_result(path, hinge_width=None, subdivisions=None) -> ResultFile:
     from .measure import element_rotations
 
     source = os.fspath(path)
-    d = parse_json(read_bytes(source), source)
+    data = read_bytes(source)
+    if not data.lstrip(b"\xef\xbb\xbf \t\r\n").startswith(b"{"):
+        raise PatternError(f"{source}: not a result FOLD file (a JSON object); "
+                           "`foldcore simulate PATTERN -o RESULT.fold` writes one")
+    d = parse_json(data, source)
     fold = fold_file_from_dict(d, source)
     frames, faces = _folded_frames(d, fold.pattern.n_edges, source)
     if fold.thickness is None:
