@@ -120,6 +120,7 @@ def test_ctrl_c_writes_the_last_iterate_marked_partial(hinge_file, tmp_path, cap
     assert fold["foldcore:partial"] is True
     assert rep["partial"] is True and rep["reason"] == "interrupted"
     assert rep["iterations"] == 29 and rep["converged"] is False
+    assert rep["timings_s"]["total"] > rep["timings_s"]["setup"]  # the run's time counts
     assert 0.0 < rep["fold_angles_deg"][0] < 90.0  # part way
     with pytest.raises(Interrupted) as info:
         calls.clear()

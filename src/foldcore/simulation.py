@@ -294,9 +294,9 @@ class Simulation:
                     _, reason = self._stage(budget, callback, limit)
                 elif branch_stage:
                     self.strategy.end_run()  # the run ends with its branch stage
-            finally:
+            finally:  # an interrupted run's time counts too
                 self.progress.stage = None
-        self.timings["total"] += time.perf_counter() - start
+                self.timings["total"] += time.perf_counter() - start
         if self.model.system.factored:  # a rigid-body run never needs K
             self.timings["bare_solve"] = self._bare_solve_floor()
         result = self.result(reason == "converged", reason)
