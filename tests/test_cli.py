@@ -309,3 +309,28 @@ def test_running_out_of_memory_is_one_line(fold_file, capsys, monkeypatch):
     assert main(["simulate", str(fold_file)]) == 2
     (line,) = capsys.readouterr().err.splitlines()
     assert line.startswith(f"foldcore: error: {fold_file}: out of memory")
+
+
+def test_reading_warnings_are_printed_before_the_run(fold_file, tmp_path, capsys,
+                                                     monkeypatch):
+    """A file without ``edges_foldAngle`` is read with a warning; it is printed when
+    the run starts, not after it (a long run kept it back until the end)."""
+    import json
+
+    from foldcore.simulation import Simulation
+
+    d = json.loads(fold_file.read_text())
+    del d["edges_foldAngle"]
+    path = tmp_path / "no_angles.fold"
+    path.write_text(json.dumps(d))
+    run = Simulation.run
+
+    def marked(self, *args, **kwargs):
+        print("RUN STARTS", file=sys.stderr)
+        return run(self, *args, **kwargs)
+
+    monkeypatch.setattr(Simulation, "run", marked)
+    assert main(["simulate", str(path), "--max-iterations", "5"]) == 0
+    lines = capsys.readouterr().err.splitlines()
+    said = [i for i, line in enumerate(lines) if "no edges_foldAngle" in line]
+    assert said and said[0] < lines.index("RUN STARTS"), lines

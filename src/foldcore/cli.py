@@ -322,7 +322,8 @@ def simulate(args) -> int:
 
     progress = _progress(args)
     try:
-        done = fold(args.pattern, callback=progress, **option_groups(args))
+        done = fold(args.pattern, callback=progress, on_start=getattr(args, "say_warnings", None),
+                    **option_groups(args))
     except Interrupted as stop:
         written = ", ".join(f"{in_flags(k)} {v}" for k, v in stop.written.items())
         if stop.partial:
@@ -495,6 +496,13 @@ def _terminate(signum, frame):
     raise Terminated()
 
 
+def _say_warnings(caught: list) -> None:
+    """Print the warnings caught so far (:func:`_warning_lines`) and forget them."""
+    for line in _warning_lines(caught):
+        print(line, file=sys.stderr)
+    caught.clear()
+
+
 def _warning_lines(caught) -> list[str]:
     """One line per kind of warning, in order of first appearance: the first message
     and how many more like it (the same text up to its numbers) followed."""
@@ -532,9 +540,9 @@ def main(argv=None) -> int:
     try:
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
+            args.say_warnings = lambda: _say_warnings(caught)  # before a long run, too
             code = COMMANDS[args.command](args)
-        for line in _warning_lines(caught):
-            print(line, file=sys.stderr)
+        _say_warnings(caught)
         return code
     except FoldcoreError as exc:
         print(f"foldcore: error: {in_flags(str(exc))}", file=sys.stderr)

@@ -114,13 +114,17 @@ class Job:
 
 
 def fold(path, *, hinges=None, reading=None, thickening=None, solving=None, outputs=None,
-         callback=None) -> Fold:
-    """:func:`simulate`, keeping what the command line reports from (a :class:`Fold`)."""
+         callback=None, on_start=None) -> Fold:
+    """:func:`simulate`, keeping what the command line reports from (a :class:`Fold`);
+    ``on_start()`` is called once the pattern is read and the model built, before the
+    run (the command line prints the reading's warnings there, not after the run)."""
     from .outputs import run_summary, write_result
 
     job = Job.make(path, hinges, reading, thickening, solving, outputs)
     loaded, thickness = _prepared(job)
     mesh, sim = _simulation(job, loaded, thickness)
+    if on_start is not None:
+        on_start()
     out, s = job.outputs, job.solving
     interrupted, sweep = False, None
     if out.animate:
