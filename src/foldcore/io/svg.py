@@ -74,13 +74,14 @@ MAX_MEETINGS = 100_000
 #: Most pairs of noded points closer than the merge distance (a few per T-join or
 #: crossing in a drawing; many lines through one point crowd there by the million).
 MAX_CLOSE_PAIRS = 1_000_000
-#: What svgelements raises on values it cannot compute (units it cannot resolve,
-#: degenerate transforms, numbers out of range): refused naming the element.
+#: An SVG number, and one followed by a unit (a length).
 _NUMBER = re.compile(r"([+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)")
 _LENGTH = re.compile(_NUMBER.pattern + r"\s*(?:px|mm|cm|in|pt|pc|em|ex|%)?")
 _SEPARATORS = re.compile(r"[\s,]+")
 #: Attributes that place a shape's points.
 _GEOMETRY = ("x", "y", "x1", "y1", "x2", "y2", "width", "height", "cx", "cy", "r", "rx", "ry")
+#: What svgelements raises on values it cannot compute (units it cannot resolve,
+#: degenerate transforms, numbers out of range): refused naming the element.
 _SVG_FAILURES = (ArithmeticError, ValueError, TypeError, IndexError, AttributeError,
                  KeyError)
 
