@@ -147,6 +147,7 @@ class CreasePattern:
         for v in np.flatnonzero(degree == 1):
             e = int(np.flatnonzero((self.edges == v).any(axis=1))[0])
             self._fail(f"edge {e} is dangling (vertex {v} has no other edge)")
+        del lengths, key, first, counts, degree  # not held through the crossing test
         self._validate_connected()
         for i, j in crossing_pairs(self.vertices, self.edges):
             self._fail(f"edges {i} and {j} cross or overlap")
