@@ -11,6 +11,8 @@ so the results are those of the one-by-one reference versions in
 """
 from __future__ import annotations
 
+from itertools import chain
+
 import numpy as np
 
 from .errors import PatternError
@@ -188,6 +190,90 @@ def trace_faces(vertices: np.ndarray, edges: np.ndarray) -> list[np.ndarray]:
     """
     corners, _, lengths = face_cycles(vertices, edges)
     return split_loops(corners, lengths)
+
+
+class Loops:
+    """Vertex loops (faces) as one array of ids and the length of each loop.
+
+    A read-only sequence of (n,) id arrays (views of ``flat``), so it goes
+    wherever a list of faces does, without an array object per face.
+
+    Parameters
+    ----------
+    flat : (N,) int64 array
+        The loops' vertex ids, concatenated.
+    lengths : (F,) int64 array
+        Ids per loop, summing to N.
+    """
+
+    __slots__ = ("flat", "lengths", "_starts")
+
+    def __init__(self, flat: np.ndarray, lengths: np.ndarray):
+        self.flat, self.lengths, self._starts = flat, lengths, None
+
+    def __len__(self) -> int:
+        return len(self.lengths)
+
+    def __getitem__(self, i):
+        if isinstance(i, slice):
+            return [self[k] for k in range(*i.indices(len(self)))]
+        if self._starts is None:
+            self._starts = loop_starts(self.lengths)
+        start = int(self._starts[i])  # IndexError past the end, as a list
+        return self.flat[start:start + int(self.lengths[i])]
+
+    def __iter__(self):
+        return iter(split_loops(self.flat, self.lengths))
+
+
+def loops_of(faces) -> Loops:
+    """Faces (a sequence of vertex-id sequences, or :class:`Loops`) as :class:`Loops`.
+
+    Lists of Python ints and 1-D integer arrays are joined at once; anything
+    else is coerced face by face with ``np.asarray(face, dtype=np.int64)``.
+    """
+    if isinstance(faces, Loops):
+        return Loops(shared_or_copy(faces.flat, np.int64),
+                     shared_or_copy(faces.lengths, np.int64))
+    faces = list(faces)
+    kinds = set(map(type, faces))
+    if kinds <= {list, tuple} and set(map(type, chain.from_iterable(faces))) <= {int}:
+        lengths = np.fromiter(map(len, faces), dtype=np.int64, count=len(faces))
+        try:
+            flat = np.fromiter(chain.from_iterable(faces), dtype=np.int64,
+                               count=int(lengths.sum()))
+        except OverflowError:  # an id beyond int64: out of range, as the slow path says
+            flat = None
+        if flat is not None:
+            return Loops(flat, lengths)
+    if not (kinds <= {np.ndarray} and all(f.ndim == 1 and f.dtype.kind in "iu" for f in faces)):
+        faces = [np.asarray(face, dtype=np.int64).ravel() for face in faces]
+    lengths = np.fromiter(map(len, faces), dtype=np.int64, count=len(faces))
+    flat = np.concatenate(faces).astype(np.int64, copy=False) if faces \
+        else np.zeros(0, dtype=np.int64)
+    return Loops(flat, lengths)
+
+
+def shared_or_copy(a: np.ndarray, dtype) -> np.ndarray:
+    """``a`` itself if it is a read-only array of ``dtype`` that no writeable array
+    holds (a reader's arrays, a pattern's: no one writes them, so they can be shared),
+    else a copy of it as ``dtype``."""
+    base = a.base
+    if a.dtype == dtype and not a.flags.writeable and (
+            base is None or isinstance(base, np.ndarray) and not base.flags.writeable):
+        return a
+    return a.astype(dtype)
+
+
+def freeze(*arrays) -> None:
+    """Make a reader's own arrays read-only, so the pattern built from them shares them
+    (:func:`shared_or_copy`) instead of holding a copy beside them; other values are
+    left as they are."""
+    for a in arrays:
+        if isinstance(a, Loops):
+            freeze(a.flat, a.lengths)
+        elif isinstance(a, np.ndarray):
+            a.setflags(write=False)
 
 
 def split_loops(flat: np.ndarray, lengths: np.ndarray) -> list[np.ndarray]:
