@@ -46,7 +46,7 @@ offending item; files above :data:`MAX_FILE_BYTES` are refused unread.
 Large files: arrays of plain numbers, ids and letters are checked with NumPy;
 from the first item that may be bad on, the row-by-row checks run, so the
 message names the same item (memory and time:
-``docs/architecture.md#reading-large-fold-files``).
+``docs/architecture.md#reading-large-files``).
 """
 from __future__ import annotations
 
