@@ -11,11 +11,17 @@ with ``foldcore.io.write_obj`` / ``write_hinges``). Every input is read with
 
 Each run is a fresh interpreter, so ``rss_mb``, its peak resident memory
 (``VmHWM`` of /proc/self/status, MiB: the JSON objects, NumPy arrays and
-GEOS geometries alike), is that read's alone; ``rss_baseline_mb`` is the peak
-after ``import foldcore`` and its readers, before the read. ``seconds`` is
-the wall time of ``foldcore.read`` inside the child (file read included,
-interpreter start and imports not). Per size and case: one warm-up run
-(discarded: page cache, .pyc), then RUNS runs; the median is reported.
+GEOS geometries alike), is that read's alone. ``rss_imports_mb`` is the peak
+after ``import foldcore`` and its readers; ``rss_baseline_mb`` the peak
+after first reads of a 3 × 3 grid in the same format and of a 3 × 3 FOLD grid
+with a twin vertex (refused), which load what a read loads on first use
+(SciPy's sparse graphs, shapely, GEOS's overlap test: ~32 MB, whatever the
+file). ``ratio`` is the read's memory above that baseline per byte of
+input (``(rss_mb − rss_baseline_mb)`` MiB / ``bytes`` MiB; OBJ: mesh and
+hinge file). ``seconds`` is the wall time of ``foldcore.read`` inside the
+child (file read included, interpreter start, imports and the first read
+not). Per size and case: one warm-up run (discarded: page cache, .pyc), then
+RUNS runs; the median is reported.
 
 ``--before SRC`` also times another source tree (e.g. the main checkout's
 ``src``, the code before a change), interleaved run by run with this one so
@@ -80,7 +86,13 @@ def peak_mb():  # this process image's own high-water mark (ru_maxrss keeps the 
         return next(int(l.split()[1]) for l in fh if l.startswith("VmHWM")) / 1024
 
 
-path = sys.argv[1]
+path, firsts = sys.argv[1], sys.argv[2:]
+rss_imports = peak_mb()
+for first in firsts:  # 3 x 3 grids: what a read loads on first use
+    try:
+        read(first)
+    except foldcore.PatternError:
+        pass
 rss0 = peak_mb()
 t = time.perf_counter()
 try:
@@ -89,8 +101,8 @@ try:
 except foldcore.PatternError as exc:
     outcome = "refused: " + str(exc).split(": ", 1)[1]
 seconds = time.perf_counter() - t
-print(json.dumps({"seconds": seconds, "outcome": outcome, "rss_baseline_mb": rss0,
-                  "rss_mb": peak_mb(), "file": foldcore.__file__}))
+print(json.dumps({"seconds": seconds, "outcome": outcome, "rss_imports_mb": rss_imports,
+                  "rss_baseline_mb": rss0, "rss_mb": peak_mb(), "file": foldcore.__file__}))
 """
 
 
@@ -102,6 +114,13 @@ def write_inputs(folder: Path, sizes, cases) -> list[dict]:
     import foldcore
     from foldcore.io import write_hinges, write_obj
 
+    first = {"fold": folder / "first.fold", "obj": folder / "first.obj",
+             "twin": folder / "first_twin_vertex.fold"}  # the first reads of each child
+    if not first["obj"].with_suffix(".hinges").exists():
+        first["fold"].write_text(json.dumps(grid_fold(3)))
+        first["twin"].write_text(json.dumps(grid_fold(3, flaw="twin_vertex")))
+        write_obj(first["obj"], foldcore.read(first["fold"]))
+        write_hinges(first["obj"].with_suffix(".hinges"), foldcore.read(first["fold"]))
     inputs = []
     for n in sizes:
         for case in FOLD_CASES:
@@ -119,6 +138,7 @@ def write_inputs(folder: Path, sizes, cases) -> list[dict]:
                 del pattern
             inputs.append({"format": "obj", "case": "valid", "n": n, "path": str(path)})
     for row in inputs:
+        row["first"] = [str(first[row["format"]]), str(first["twin"])]
         row["vertices"] = row["n"] ** 2
         row["bytes"] = os.path.getsize(row["path"])
         if row["format"] == "obj":
@@ -126,12 +146,13 @@ def write_inputs(folder: Path, sizes, cases) -> list[dict]:
     return inputs
 
 
-def run_child(src: Path, path: str) -> dict:
-    """One read of ``path`` by the tree ``src`` in a fresh interpreter, with the load."""
+def run_child(src: Path, path: str, first: list) -> dict:
+    """One read of ``path`` by the tree ``src`` in a fresh interpreter, after reads of
+    the files ``first`` (module docstring), with the load."""
     env = dict(os.environ, PYTHONPATH=str(src))
     start, busy0 = time.perf_counter(), _meta.busy_seconds()
     cpu0 = resource.getrusage(resource.RUSAGE_CHILDREN)
-    proc = subprocess.run([sys.executable, "-c", PROBE, path], capture_output=True,
+    proc = subprocess.run([sys.executable, "-c", PROBE, path, *first], capture_output=True,
                           text=True, env=env, timeout=CHILD_TIMEOUT_S, check=True)
     wall = time.perf_counter() - start
     cpu1 = resource.getrusage(resource.RUSAGE_CHILDREN)
@@ -145,6 +166,7 @@ def run_child(src: Path, path: str) -> dict:
 def summary(runs: list[dict]) -> dict:
     return {"seconds": _meta.median(r["seconds"] for r in runs),
             "rss_mb": _meta.median(r["rss_mb"] for r in runs),
+            "rss_imports_mb": _meta.median(r["rss_imports_mb"] for r in runs),
             "rss_baseline_mb": _meta.median(r["rss_baseline_mb"] for r in runs),
             "others_busy": _meta.median(r["others_busy"] for r in runs),
             "outcome": runs[0]["outcome"], "runs": len(runs),
@@ -158,11 +180,11 @@ def measure(row: dict, trees: dict, once: set, runs: int) -> dict:
     done = {name: [] for name in trees}
     for name, src in trees.items():
         if name not in once:
-            run_child(src, row["path"])  # warm-up, discarded
+            run_child(src, row["path"], row["first"])  # warm-up, discarded
     for i in range(runs):
         for name, src in trees.items():
             if not (i and name in once):
-                done[name].append(run_child(src, row["path"]))
+                done[name].append(run_child(src, row["path"], row["first"]))
     return {name: summary(r) for name, r in done.items()}
 
 
@@ -194,7 +216,10 @@ def grids(args, trees: dict) -> list:
             plan = reference_plan(row, trees, previous.get(key), bool(args.cases))
             result = measure(row, *plan, QUICK_RUNS if args.quick else RUNS)
             previous[key] = result
-            rows.append({k: v for k, v in row.items() if k != "path"} | result)
+            rows.append({k: v for k, v in row.items() if k not in ("path", "first")}
+                        | result)
+            for r in result.values():
+                r["ratio"] = ratio(r, row["bytes"])
             if "before" in result:
                 rows[-1]["same_outcome"] = result["before"]["outcome"] == \
                     result["after"]["outcome"]
@@ -281,22 +306,30 @@ def plot(data: dict, path: Path) -> None:
     _meta.save(fig, path)
 
 
+def ratio(result: dict, size: int) -> float:
+    """A read's peak memory above its baseline per byte of input (module docstring)."""
+    return (result["rss_mb"] - result["rss_baseline_mb"]) * 2 ** 20 / size
+
+
 def table(data: dict) -> str:
-    """Per input: vertices, read seconds and peak RSS (and the reference tree's), outcome."""
+    """Per input: vertices, file size, read seconds, peak RSS and its ratio to the file
+    size (and the reference tree's), outcome."""
     before = any("before" in r for r in data["rows"])
     rows = []
     for r in data["rows"]:
         a = r["after"]
         cells = [f"{r['format'].upper()} {r['case'].replace('_', ' ')}", f"{r['vertices']:,}",
-                 _meta.sig(a["seconds"]), f"{a['rss_mb']:.0f}"]
+                 _meta.sig(r["bytes"] / 2 ** 20), _meta.sig(a["seconds"]), f"{a['rss_mb']:.0f}",
+                 f"{ratio(a, r['bytes']):.1f}"]
         if before:
             b = r.get("before")
-            cells += ["—", "—"] if b is None else [
+            cells += ["—", "—", "—"] if b is None else [
                 _meta.sig(b["seconds"]) + (" (1 run)" if b["runs"] == 1 else ""),
-                f"{b['rss_mb']:.0f}"]
+                f"{b['rss_mb']:.0f}", f"{ratio(b, r['bytes']):.1f}"]
         rows.append(cells + [a["outcome"].split(":")[0]])
-    header = ["input", "vertices", "read (s)", "peak RSS (MB)"]
-    header += ["before: read (s)", "before: peak RSS (MB)"] if before else []
+    header = ["input", "vertices", "file (MiB)", "read (s)", "peak RSS (MiB)",
+              "above baseline ÷ file"]
+    header += ["before: read (s)", "before: peak RSS (MiB)", "before: ÷ file"] if before else []
     return _meta.markdown_table(header + ["outcome"], rows)
 
 
@@ -331,7 +364,8 @@ def main() -> None:
     record = _meta.Record("reading", args, runs=QUICK_RUNS if args.quick else RUNS,
                           slow_s=SLOW_S, before=str(args.before) if args.before else None,
                           input="tests/grids.py grid_fold(n), unit lattice, mm, faces given",
-                          units={"seconds": "s", "rss_mb": "MiB (VmHWM)"})
+                          units={"seconds": "s", "rss_mb": "MiB (VmHWM)",
+                                 "ratio": "(rss_mb - rss_baseline_mb) MiB / input MiB"})
     rows = grids(args, trees)
     record.meta["sizes_n"] = sorted({r["n"] for r in rows})
     record.write({"rows": rows}, plot)

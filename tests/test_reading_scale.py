@@ -2,10 +2,12 @@
 
 The planar helpers are compared with their one-by-one twins in
 ``tests/naive.py``, the FOLD reader's at-once paths with its row-by-row paths,
-and a 10⁵-vertex grid is read (its speed is measured in bench/reading.py, not
-here).
+a 10⁵-vertex grid is read (its speed is measured in bench/reading.py, not
+here), and a 10⁴-vertex grid read as FOLD and as OBJ peaks below 20 × its size.
 """
 import json
+import os
+import tracemalloc
 import warnings
 
 import numpy as np
@@ -15,9 +17,10 @@ from naive import crossing_pairs as naive_crossings
 from naive import derive_faces as naive_derive
 from naive import trace_faces as naive_trace
 
+import foldcore
 from foldcore import planar
 from foldcore.errors import PatternError, PatternWarning
-from foldcore.io import read_fold
+from foldcore.io import fold, read_fold, write_hinges, write_obj
 from foldcore.io.fold import parse_fold, pattern_from_fold_dict
 from foldcore.pattern import CreasePattern
 
@@ -187,6 +190,46 @@ def test_a_1e5_vertex_grid_reads(tmp_path):
     assert p.n_edges == 3 * 317 ** 2 - 4 * 317 + 1 and len(p.faces) == 2 * 316 ** 2
     assert (p.edge_faces >= 0).sum() == 2 * p.n_edges - 4 * 316
     assert abs(p.area() - 316.0 ** 2) < 1e-6
+
+
+def grid_files(folder, n: int, fmt: str):
+    """The n × n grid as ``folder``/grid.fold, or as grid.obj + grid.hinges; the path
+    and the input's size in bytes (OBJ: both files)."""
+    path = folder / "grid.fold"
+    path.write_text(json.dumps(grid_fold(n)))
+    if fmt == "fold":
+        return path, path.stat().st_size
+    pattern = read_fold(path)
+    path = folder / "grid.obj"
+    write_obj(path, pattern)
+    write_hinges(path.with_suffix(".hinges"), pattern)
+    return path, path.stat().st_size + path.with_suffix(".hinges").stat().st_size
+
+
+@pytest.mark.parametrize("fmt", ["fold", "obj"])
+def test_a_read_peaks_below_20_times_the_files_size(tmp_path, monkeypatch, fmt):
+    """The peak of a read's Python allocations (NumPy's arrays included), measured
+    by tracemalloc, is at most 20 × the input's size; bench/reading.py measures the
+    process's resident memory from 10³ to 10⁶ vertices."""
+    (tmp_path / "first").mkdir()
+    foldcore.read(grid_files(tmp_path / "first", 3, fmt)[0])  # imports, first-use caches
+    path, size = grid_files(tmp_path, 100, fmt)
+    # read_bytes asks for a buffer as large as the file limit, resident only as far
+    # as the file fills it; tracemalloc counts all of it, so the limit is the files'
+    monkeypatch.setattr(fold, "MAX_FILE_BYTES", max(os.path.getsize(p) for p in
+                                                    tmp_path.glob("grid.*")))
+    was_tracing = tracemalloc.is_tracing()
+    tracemalloc.start()
+    tracemalloc.reset_peak()
+    before = tracemalloc.get_traced_memory()[0]
+    try:
+        pattern = foldcore.read(path)
+        peak = tracemalloc.get_traced_memory()[1] - before
+    finally:
+        if not was_tracing:
+            tracemalloc.stop()
+    assert pattern.n_vertices == 100 ** 2
+    assert peak <= 20 * size, f"peak {peak / size:.1f} × the input's {size} bytes"
 
 
 def test_huge_number_still_refused_by_the_hook():

@@ -5,19 +5,20 @@ Units: coordinates, widths in mm; angles in degrees, valley positive (FOLD).
 from __future__ import annotations
 
 import warnings
-from itertools import chain
 
 import numpy as np
 
 from .errors import PatternError, PatternWarning
 from .planar import (
+    Loops,
     crossing_pairs,
     derive_face_loops,
     loop_starts,
+    loops_of,
     next_in_loop,
+    shared_or_copy,
     signed_area,
     signed_areas,
-    split_loops,
 )
 
 #: Assignments foldcore simulates. ``C`` (cut) and ``J`` (join) are refused.
@@ -52,10 +53,14 @@ class CreasePattern:
     max_angles : (E,) array_like of float or None, optional
         Largest fold magnitude per crease in degrees, in (0, 180]. Default 180.
     faces : sequence of (n,) int arrays, optional
-        Panels as vertex loops. Derived from the planar graph when omitted.
-        Clockwise loops are reversed with a :class:`PatternWarning`.
+        Panels as vertex loops (or :class:`foldcore.planar.Loops`). Derived from
+        the planar graph when omitted. Clockwise loops are reversed with a
+        :class:`PatternWarning`.
     source : str, optional
         File name (or description) used in every error message.
+
+    NumPy arrays of the pattern's own dtypes that are already read-only (a
+    reader's, another pattern's) are shared, not copied; the others are copied.
 
     Raises
     ------
@@ -80,11 +85,26 @@ class CreasePattern:
         if faces is None:
             flat, lengths = derive_face_loops(self.vertices, self.edges, boundary, source)
         else:
-            flat, lengths = self._counter_clockwise(*_face_loops(faces))
-        self.faces = tuple(split_loops(_frozen(flat), lengths))
+            loops = loops_of(faces)
+            flat, lengths = self._counter_clockwise(loops.flat, loops.lengths)
+        self._loops = Loops(_frozen(flat), _frozen(lengths))
+        self._faces = None
         self.edge_faces = _frozen(self._match_faces(flat, lengths))
 
     # ----------------------------------------------------------------- queries
+    @property
+    def faces(self) -> tuple:
+        """Panels as counter-clockwise vertex loops: a tuple of (n,) int64 arrays,
+        read-only views of one array, made on first use."""
+        if self._faces is None:
+            self._faces = tuple(self._loops)
+        return self._faces
+
+    @property
+    def face_loops(self) -> Loops:
+        """The faces as one array of vertex ids and the length of each loop."""
+        return self._loops
+
     @property
     def n_vertices(self) -> int:
         return len(self.vertices)
@@ -116,7 +136,7 @@ class CreasePattern:
         """A copy with some per-edge arrays replaced (re-validated)."""
         args = dict(vertices=self.vertices, edges=self.edges, assignments=self.assignments,
                     fold_angles=self.fold_angles, widths=self.widths,
-                    max_angles=self.max_angles, faces=list(self.faces), source=self.source)
+                    max_angles=self.max_angles, faces=self._loops, source=self.source)
         args.update(changes)
         return CreasePattern(**args)
 
@@ -124,7 +144,7 @@ class CreasePattern:
         counts = {a: int(np.count_nonzero(self.assignments == a)) for a in ASSIGNMENTS}
         summary = " ".join(f"{a}={n}" for a, n in counts.items() if n)
         return (f"CreasePattern({self.source!r}: {self.n_vertices} vertices, "
-                f"{self.n_edges} edges [{summary}], {len(self.faces)} faces)")
+                f"{self.n_edges} edges [{summary}], {len(self._loops)} faces)")
 
     # -------------------------------------------------------------- validation
     def _fail(self, message: str):
@@ -147,6 +167,7 @@ class CreasePattern:
         for v in np.flatnonzero(degree == 1):
             e = int(np.flatnonzero((self.edges == v).any(axis=1))[0])
             self._fail(f"edge {e} is dangling (vertex {v} has no other edge)")
+        del lengths, key, first, counts, degree  # not held through the crossing test
         self._validate_connected()
         for i, j in crossing_pairs(self.vertices, self.edges):
             self._fail(f"edges {i} and {j} cross or overlap")
@@ -264,31 +285,6 @@ class CreasePattern:
         return edge_faces
 
 
-def _face_loops(faces) -> tuple[np.ndarray, np.ndarray]:
-    """Faces (a sequence of vertex-id sequences) as concatenated ids and lengths.
-
-    Lists of Python ints and 1-D integer arrays are joined at once; anything
-    else is coerced face by face with ``np.asarray(face, dtype=np.int64)``.
-    """
-    faces = list(faces)
-    kinds = set(map(type, faces))
-    if kinds <= {list, tuple} and set(map(type, chain.from_iterable(faces))) <= {int}:
-        lengths = np.fromiter(map(len, faces), dtype=np.int64, count=len(faces))
-        try:
-            flat = np.fromiter(chain.from_iterable(faces), dtype=np.int64,
-                               count=int(lengths.sum()))
-        except OverflowError:  # an id beyond int64: out of range, as the slow path says
-            flat = None
-        if flat is not None:
-            return flat, lengths
-    if not (kinds <= {np.ndarray} and all(f.ndim == 1 and f.dtype.kind in "iu" for f in faces)):
-        faces = [np.asarray(face, dtype=np.int64).ravel() for face in faces]
-    lengths = np.fromiter(map(len, faces), dtype=np.int64, count=len(faces))
-    flat = np.concatenate(faces).astype(np.int64, copy=False) if faces \
-        else np.zeros(0, dtype=np.int64)
-    return flat, lengths
-
-
 def _reversed_loops(flat, starts, lengths, flip) -> np.ndarray:
     """``flat`` with the loops where ``flip`` is True in reverse vertex order."""
     if not flip.any():
@@ -351,7 +347,7 @@ def _as_edges(edges, n_vertices: int, source: str) -> np.ndarray:
                              | ~np.isfinite(as_float).all(axis=1))
         if len(bad):
             raise PatternError(f"{source}: edge {bad[0]} has a non-integer vertex id")
-    e = raw.astype(np.int64)
+    e = shared_or_copy(raw, np.int64)
     bad = np.flatnonzero(((e < 0) | (e >= n_vertices)).any(axis=1))
     if len(bad):
         raise PatternError(f"{source}: edge {bad[0]} refers to vertex "
@@ -395,7 +391,10 @@ def _per_edge(values, n_edges: int, default: float, name: str, source: str) -> n
     if values is None:
         return np.full(n_edges, default, dtype=np.float64)
     try:
-        out = np.array([np.nan if x is None else x for x in values], dtype=np.float64)
+        if isinstance(values, np.ndarray) and values.ndim == 1 and values.dtype.kind in "fiu":
+            out = shared_or_copy(values, np.float64)
+        else:
+            out = np.array([np.nan if x is None else x for x in values], dtype=np.float64)
     except (TypeError, ValueError):
         raise PatternError(f"{source}: {name} must be numbers or null") from None
     if out.shape != (n_edges,):

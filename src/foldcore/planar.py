@@ -11,6 +11,8 @@ so the results are those of the one-by-one reference versions in
 """
 from __future__ import annotations
 
+from itertools import chain
+
 import numpy as np
 
 from .errors import PatternError
@@ -19,8 +21,9 @@ from .errors import PatternError
 _SURE = 1e-9
 #: Below this |value| a product may have lost its relative precision (subnormal range).
 _TINY = 1e-280
-#: Candidate edge pairs classified per block (memory: ~100 bytes a pair).
-_BLOCK_PAIRS = 4_000_000
+#: Candidate edge pairs classified per block: as many as edges, within these bounds
+#: (memory: ~200 bytes a pair, so at most ~6 MB; larger blocks are no faster).
+_BLOCK_PAIRS = (1024, 32_768)
 #: Smallest angle (radians) between two edges at a vertex below which the
 #: crossing test checks each pair of edges sharing a vertex for overlap.
 _MIN_GAP_RAD = 1e-6
@@ -189,6 +192,90 @@ def trace_faces(vertices: np.ndarray, edges: np.ndarray) -> list[np.ndarray]:
     return split_loops(corners, lengths)
 
 
+class Loops:
+    """Vertex loops (faces) as one array of ids and the length of each loop.
+
+    A read-only sequence of (n,) id arrays (views of ``flat``), so it goes
+    wherever a list of faces does, without an array object per face.
+
+    Parameters
+    ----------
+    flat : (N,) int64 array
+        The loops' vertex ids, concatenated.
+    lengths : (F,) int64 array
+        Ids per loop, summing to N.
+    """
+
+    __slots__ = ("flat", "lengths", "_starts")
+
+    def __init__(self, flat: np.ndarray, lengths: np.ndarray):
+        self.flat, self.lengths, self._starts = flat, lengths, None
+
+    def __len__(self) -> int:
+        return len(self.lengths)
+
+    def __getitem__(self, i):
+        if isinstance(i, slice):
+            return [self[k] for k in range(*i.indices(len(self)))]
+        if self._starts is None:
+            self._starts = loop_starts(self.lengths)
+        start = int(self._starts[i])  # IndexError past the end, as a list
+        return self.flat[start:start + int(self.lengths[i])]
+
+    def __iter__(self):
+        return iter(split_loops(self.flat, self.lengths))
+
+
+def loops_of(faces) -> Loops:
+    """Faces (a sequence of vertex-id sequences, or :class:`Loops`) as :class:`Loops`.
+
+    Lists of Python ints and 1-D integer arrays are joined at once; anything
+    else is coerced face by face with ``np.asarray(face, dtype=np.int64)``.
+    """
+    if isinstance(faces, Loops):
+        return Loops(shared_or_copy(faces.flat, np.int64),
+                     shared_or_copy(faces.lengths, np.int64))
+    faces = list(faces)
+    kinds = set(map(type, faces))
+    if kinds <= {list, tuple} and set(map(type, chain.from_iterable(faces))) <= {int}:
+        lengths = np.fromiter(map(len, faces), dtype=np.int64, count=len(faces))
+        try:
+            flat = np.fromiter(chain.from_iterable(faces), dtype=np.int64,
+                               count=int(lengths.sum()))
+        except OverflowError:  # an id beyond int64: out of range, as the slow path says
+            flat = None
+        if flat is not None:
+            return Loops(flat, lengths)
+    if not (kinds <= {np.ndarray} and all(f.ndim == 1 and f.dtype.kind in "iu" for f in faces)):
+        faces = [np.asarray(face, dtype=np.int64).ravel() for face in faces]
+    lengths = np.fromiter(map(len, faces), dtype=np.int64, count=len(faces))
+    flat = np.concatenate(faces).astype(np.int64, copy=False) if faces \
+        else np.zeros(0, dtype=np.int64)
+    return Loops(flat, lengths)
+
+
+def shared_or_copy(a: np.ndarray, dtype) -> np.ndarray:
+    """``a`` itself if it is a read-only array of ``dtype`` that no writeable array
+    holds (a reader's arrays, a pattern's: no one writes them, so they can be shared),
+    else a copy of it as ``dtype``."""
+    base = a.base
+    if a.dtype == dtype and not a.flags.writeable and (
+            base is None or isinstance(base, np.ndarray) and not base.flags.writeable):
+        return a
+    return a.astype(dtype)
+
+
+def freeze(*arrays) -> None:
+    """Make a reader's own arrays read-only, so the pattern built from them shares them
+    (:func:`shared_or_copy`) instead of holding a copy beside them; other values are
+    left as they are."""
+    for a in arrays:
+        if isinstance(a, Loops):
+            freeze(a.flat, a.lengths)
+        elif isinstance(a, np.ndarray):
+            a.setflags(write=False)
+
+
 def split_loops(flat: np.ndarray, lengths: np.ndarray) -> list[np.ndarray]:
     """``flat`` cut into consecutive pieces of ``lengths`` (views, read-only if it is)."""
     ends = np.cumsum(lengths).tolist()
@@ -281,28 +368,45 @@ def box_pairs(vertices: np.ndarray, edges: np.ndarray):
     bounding boxes meet, each pair once; see :func:`crossing_pairs`."""
     p, q = vertices[edges[:, 0]], vertices[edges[:, 1]]
     lo, hi = np.minimum(p, q), np.maximum(p, q)
+    del p, q
     plan = _grid_plan(lo, hi)
+    block = min(max(len(edges), _BLOCK_PAIRS[0]), _BLOCK_PAIRS[1])
     if plan is None:
-        yield from _tree_pairs(vertices, edges)
+        del lo, hi
+        yield from _tree_pairs(vertices, edges, block)
         return
-    order = plan[0]
+    order, starts, counts, links = plan
     # boxes in cell order, one contiguous array per side (cheap gathers)
     x0, y0, x1, y1 = (np.ascontiguousarray(c[order]) for c in (lo[:, 0], lo[:, 1],
                                                                hi[:, 0], hi[:, 1]))
-    for a, b, same in _grid_blocks(*plan[1:]):
-        meet = np.flatnonzero((x0[a] <= x1[b]) & (x0[b] <= x1[a]) & (a < b if same else True))
-        a, b = a[meet], b[meet]
-        meet = (y0[a] <= y1[b]) & (y0[b] <= y1[a])
-        a, b = order[a[meet]], order[b[meet]]
-        yield np.minimum(a, b), np.maximum(a, b)
+    del lo, hi  # held while the blocks are classified
+    for cells in _grid_blocks(counts, links, block):
+        yield _meeting((x0, y0, x1, y1), order, starts, counts, *cells)
 
 
-def _tree_pairs(vertices, edges):
+def _meeting(boxes, order, starts, counts, here, there, n, same):
+    """(left, right): the pairs of edges of one block of linked cells (``here[k]`` with
+    ``there[k]``, ``n[k]`` pairs) whose boxes meet, as edge ids, left < right; the
+    block's temporaries are freed on return, before its pairs are classified."""
+    x0, y0, x1, y1 = boxes
+    pair = np.repeat(np.arange(len(n)), n)
+    rank = np.arange(int(n.sum())) - np.repeat(np.cumsum(n) - n, n)
+    width = counts[there][pair]
+    a, b = starts[here][pair] + rank // width, starts[there][pair] + rank % width
+    del pair, rank, width
+    meet = np.flatnonzero((x0[a] <= x1[b]) & (x0[b] <= x1[a]) & (a < b if same else True))
+    a, b = a[meet], b[meet]
+    meet = (y0[a] <= y1[b]) & (y0[b] <= y1[a])
+    a, b = order[a[meet]], order[b[meet]]
+    return np.minimum(a, b), np.maximum(a, b)
+
+
+def _tree_pairs(vertices, edges, pairs: int):
     import shapely
 
     lines = shapely.linestrings(vertices[edges])
     tree = shapely.STRtree(lines)
-    block = max(1, _BLOCK_PAIRS // 16)  # ~16 box neighbours per edge on a mesh
+    block = max(1, pairs // 16)  # ~16 box neighbours per edge on a mesh
     for s in range(0, len(edges), block):
         left, right = tree.query(lines[s:s + block])
         left += s
@@ -348,19 +452,15 @@ def _grid_plan(lo: np.ndarray, hi: np.ndarray):
     return order, starts, counts, links
 
 
-def _grid_blocks(starts, counts, links):
-    """(a, b, same cell): positions in cell order of every pair of edges in linked
-    cells, in blocks of about :data:`_BLOCK_PAIRS`."""
+def _grid_blocks(counts, links, block: int):
+    """(here, there, pairs per cell pair, same cell): the linked cells in blocks of
+    about ``block`` edge pairs (:func:`_meeting` lists a block's pairs)."""
     for here, there, same in links:
         n = counts[here] * counts[there]
         ends = np.cumsum(n)
-        cuts = np.searchsorted(ends, np.arange(_BLOCK_PAIRS, int(ends[-1]) if len(n) else 0,
-                                               _BLOCK_PAIRS))
+        cuts = np.searchsorted(ends, np.arange(block, int(ends[-1]) if len(n) else 0, block))
         for h, t, k in zip(np.split(here, cuts), np.split(there, cuts), np.split(n, cuts)):
-            pair = np.repeat(np.arange(len(k)), k)
-            rank = np.arange(int(k.sum())) - np.repeat(np.cumsum(k) - k, k)
-            width = counts[t][pair]
-            yield starts[h][pair] + rank // width, starts[t][pair] + rank % width, same
+            yield h, t, k, same
 
 
 def _crowded_vertices(vertices: np.ndarray, edges: np.ndarray) -> np.ndarray | None:

@@ -46,7 +46,7 @@ offending item; files above :data:`MAX_FILE_BYTES` are refused unread.
 Large files: arrays of plain numbers, ids and letters are checked with NumPy;
 from the first item that may be bad on, the row-by-row checks run, so the
 message names the same item (memory and time:
-``docs/architecture.md#reading-large-fold-files``).
+``docs/architecture.md#reading-large-files``).
 """
 from __future__ import annotations
 
@@ -60,7 +60,7 @@ from .. import limits
 from ..errors import PatternError
 from ..hinges import HINGE_MODELS
 from ..pattern import DEFAULT_MAX_ANGLE_DEG, CreasePattern
-from ..planar import derive_face_loops, has_repeats, loop_starts, next_in_loop
+from ..planar import Loops, derive_face_loops, freeze, has_repeats, loop_starts, next_in_loop
 from .conventions import Reading, assigned_angles, into_plane, note, trust_signs
 from .fold_json import (ARRAY, CELLS_KEY, EDGE_STIFFNESS_KEY,  # noqa: F401  (part of this API)
                         FACE_STIFFNESS_KEY, HINGE_KEY, MAX_ANGLE_KEY, POISSON_KEY, TARGET_KEY,
@@ -132,7 +132,9 @@ def parse_fold(data: bytes, source: str = "<fold>",
     reading : Reading, optional
         Conventions and scaling (default: Origami Simulator's, :mod:`.conventions`).
     """
-    return fold_file_from_dict(parse_json(data, source), source, reading)
+    d = parse_json(data, source)
+    del data  # the bytes go now, unless the caller keeps them
+    return _fold_file(d, source, reading, owned=True)
 
 
 def pattern_from_fold_dict(d, source: str = "<fold>") -> CreasePattern:
@@ -150,6 +152,19 @@ def pattern_from_fold_dict(d, source: str = "<fold>") -> CreasePattern:
 
 def fold_file_from_dict(d, source: str = "<fold>", reading: Reading | None = None) -> FoldFile:
     """Like :func:`pattern_from_fold_dict`, also returning thickness and unit."""
+    return _fold_file(d, source, reading, owned=False)
+
+
+#: The keys :func:`_fold_file` converts to arrays before it builds the pattern.
+_PATTERN_KEYS = ("vertices_coords", "vertices_flatUnfoldCoords", "faces_vertices",
+                 "edges_vertices", "edges_assignment", "edges_foldAngle", "edges_foldAngles",
+                 TARGET_KEY, WIDTH_KEY, MAX_ANGLE_KEY)
+
+
+def _fold_file(d, source: str, reading: Reading | None, owned: bool) -> FoldFile:
+    """:func:`fold_file_from_dict`; ``owned``: ``d`` was parsed here, so the lists of
+    :data:`_PATTERN_KEYS` are dropped from it once converted, before the pattern is
+    built (as Python objects they take about 7 × the file's size)."""
     reading = Reading() if reading is None else reading
     if not isinstance(d, dict):
         fail(source, f"the top level must be a JSON object, got {type(d).__name__}")
@@ -157,6 +172,7 @@ def fold_file_from_dict(d, source: str = "<fold>", reading: Reading | None = Non
     rows = _crease_pattern_coords(d, source)
     faces = _faces(d, len(rows), source)
     vertices = _coords(rows, scale, source, faces)
+    del rows
     factor = reading.factor(_extent(vertices))
     if factor != 1.0:
         vertices, scale = np.asarray(vertices, dtype=np.float64) * factor, scale * factor
@@ -165,19 +181,28 @@ def fold_file_from_dict(d, source: str = "<fold>", reading: Reading | None = Non
     assignments = _assignments(d, vertices, edges, source)
     widths = _per_edge(d, WIDTH_KEY, n, source)
     max_angles = _per_edge(d, MAX_ANGLE_KEY, n, source)
-    args = dict(
-        vertices=vertices, edges=edges, assignments=assignments,
-        fold_angles=_fold_angles(d, assignments, source, reading, max_angles),
-        widths=None if widths is None else [
-            None if w is None else _scaled(w, scale, f"{WIDTH_KEY}[{e}] (edge {e})", source,
-                                           vertices=vertices)
-            for e, w in enumerate(widths)],
-        max_angles=None if max_angles is None else
-        [DEFAULT_MAX_ANGLE_DEG if m is None else m for m in max_angles],
-        faces=faces, source=source)
+    fold_angles = _floats(_fold_angles(d, assignments, source, reading, max_angles))
+    widths = None if widths is None else _floats([
+        None if w is None else _scaled(w, scale, f"{WIDTH_KEY}[{e}] (edge {e})", source,
+                                       vertices=vertices)
+        for e, w in enumerate(widths)])
+    max_angles = None if max_angles is None else _floats(
+        [DEFAULT_MAX_ANGLE_DEG if m is None else m for m in max_angles])
+    if owned:
+        for key in _PATTERN_KEYS:
+            d.pop(key, None)
+    freeze(vertices, edges, fold_angles, widths, max_angles, faces)
+    args = dict(vertices=vertices, edges=edges, assignments=assignments,
+                fold_angles=fold_angles, widths=widths, max_angles=max_angles, faces=faces,
+                source=source)
     pattern = build_pattern(args)
     return FoldFile(pattern, _thickness(d, scale, source, vertices), unit,
                     _stiffness(d, n, args["faces"], source), _hinge_models(d, n, source))
+
+
+def _floats(values: list | None) -> np.ndarray | None:
+    """A checked per-edge list of numbers and None as a float array (None → NaN)."""
+    return None if values is None else np.array(values, dtype=np.float64)
 
 
 def read_bytes(path, limit: int | None = None) -> bytes:
@@ -306,15 +331,17 @@ def _edges_by_row(rows, n_vertices: int, source: str, start: int):
     return out if start == 0 else np.array(out, dtype=np.int64).reshape(-1, 2)
 
 
-def _faces(d: dict, n_vertices: int, source: str) -> list[list[int]] | None:
+def _faces(d: dict, n_vertices: int, source: str) -> Loops | list[list[int]] | None:
+    """``faces_vertices`` as :class:`Loops` (lists of int ids in range, at once), else
+    checked face by face from the first suspect one; None when absent or empty."""
     raw = d.get("faces_vertices")
     if raw is None or isinstance(raw, ARRAY) and not raw:
         return None
     if not isinstance(raw, ARRAY):
         fail(source, f"faces_vertices must be a list, got {type(raw).__name__}")
-    first = _first_bad_face(raw, n_vertices)
-    if first is None:
-        return list(raw)
+    first = _face_loops(raw, n_vertices)
+    if isinstance(first, Loops):
+        return first
     out = [list(row) for row in raw[:first]]
     for i, row in enumerate(raw[first:], first):
         ids = [index(x, n_vertices) for x in row] if isinstance(row, ARRAY) else [None]
@@ -325,9 +352,9 @@ def _faces(d: dict, n_vertices: int, source: str) -> list[list[int]] | None:
     return out
 
 
-def _first_bad_face(raw, n_vertices: int) -> int | None:
-    """None if every face is a list of int ids in range, else the first face that may
-    not be (0 when the faces are not plain int lists)."""
+def _face_loops(raw, n_vertices: int) -> Loops | int:
+    """The faces as :class:`Loops` if every face is a list of int ids in range, else
+    the first face that may not be (0 when the faces are not plain int lists)."""
     if not set(map(type, raw)) <= {list, tuple} \
             or not set(map(type, chain.from_iterable(raw))) <= {int}:
         return 0
@@ -338,7 +365,7 @@ def _first_bad_face(raw, n_vertices: int) -> int | None:
         return 0
     bad = (flat < 0) | (flat >= n_vertices)
     if not bad.any():
-        return None
+        return Loops(flat, lengths)
     return int(np.searchsorted(np.cumsum(lengths), np.argmax(bad), side="right"))
 
 

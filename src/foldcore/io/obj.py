@@ -12,7 +12,9 @@ Mesh (lengths in mm)
   must be exactly 84 + 50 × (triangle count) bytes; an ASCII STL's every
   ``outer loop`` needs its ``endloop`` (a truncated file is refused).
 
-Mesh and hinge files above :data:`foldcore.io.MAX_FILE_BYTES` are refused unread.
+Mesh and hinge files above :data:`foldcore.io.MAX_FILE_BYTES` are refused unread;
+the others are read a chunk of lines at a time into flat arrays (memory:
+``docs/architecture.md#reading-large-files``).
 
 Each face is a panel; clockwise faces are reversed (with a warning).
 
@@ -47,6 +49,7 @@ from __future__ import annotations
 
 import math
 import os
+from array import array
 from pathlib import Path
 
 import numpy as np
@@ -54,13 +57,15 @@ import numpy as np
 from .. import files, limits
 from ..errors import PatternError
 from ..pattern import DEFAULT_MAX_ANGLE_DEG, CreasePattern
-from ..planar import loop_starts, next_in_loop
+from ..planar import Loops, freeze, loop_starts, loops_of, next_in_loop
 from .fold import build_pattern, read_bytes
 from .fold_json import short
 
 HINGE_SUFFIX = ".hinges"
 HINGE_KINDS = ("M", "V", "F", "U")
 STL_RECORD = np.dtype([("normal", "<f4", 3), ("v", "<f4", (3, 3)), ("attr", "<u2")])
+#: Characters decoded and split into lines at a time: a file's lines are never all held.
+CHUNK_CHARS = 1 << 14
 
 
 def mesh_edges(faces) -> np.ndarray:
@@ -68,7 +73,7 @@ def mesh_edges(faces) -> np.ndarray:
 
     Parameters
     ----------
-    faces : sequence of (n,) int arrays
+    faces : sequence of (n,) int arrays, or :class:`foldcore.planar.Loops`
         Faces as 0-based vertex loops, in file order.
 
     Returns
@@ -85,12 +90,12 @@ def _edge_table(faces) -> tuple[np.ndarray, np.ndarray]:
     At once: the sides of all faces in file order, each keyed by its sorted
     vertex pair; an edge is a key's first side, edges ordered by that side.
     """
-    faces = [f for f in faces if len(f)]  # an empty face has no sides
-    lengths = np.fromiter(map(len, faces), dtype=np.int64, count=len(faces))
-    if not faces:
+    loops = loops_of(faces)
+    lengths = loops.lengths[loops.lengths > 0]  # an empty face has no sides
+    if not len(lengths):
         return np.zeros((0, 2), dtype=np.int64), np.zeros(0, dtype=np.int64)
-    flat = np.concatenate([np.asarray(f, dtype=np.int64).ravel() for f in faces])
-    a, b = flat, flat[next_in_loop(loop_starts(lengths), lengths)]
+    a = loops.flat
+    b = a[next_in_loop(loop_starts(lengths), lengths)]
     lo, hi = np.minimum(a, b), np.maximum(a, b)
     key = (lo - lo.min()) * (int(hi.max()) - int(lo.min()) + 1) + (hi - lo.min())
     _, first, counts = np.unique(key, return_index=True, return_counts=True)
@@ -129,12 +134,18 @@ def mesh_pattern(vertices, faces, hinge_data: bytes, source: str,
     vertices, faces
         :func:`parse_polygons` output.
     hinge_data : bytes
-        The hinge file's bytes.
+        The hinge file's bytes (UTF-8; a bad byte reads as U+FFFD).
     source, hinge_source : str
         Names of the mesh and hinge files, used in error messages.
     """
-    table = parse_hinges(_text(hinge_data), hinge_source, len(mesh_edges(faces)))
-    return pattern_from_mesh(vertices, faces, table, f"{source} (hinges {hinge_source})")
+    label = f"{source} (hinges {hinge_source})"
+    edges, counts = _edge_table(faces)
+    values = _edge_values(vertices, counts,
+                          _hinge_rows(hinge_data, hinge_source, len(edges)), label)
+    del hinge_data, counts  # the bytes go now, unless the caller keeps them
+    freeze(edges, *values.values())
+    return build_pattern(dict(vertices=vertices, edges=edges, faces=faces, source=label,
+                              **values))
 
 
 def default_hinge_path(mesh_path) -> str:
@@ -147,16 +158,17 @@ def default_hinge_path(mesh_path) -> str:
     return hinge
 
 
-def read_polygons(path) -> tuple[np.ndarray, list[np.ndarray]]:
+def read_polygons(path) -> tuple[np.ndarray, Loops]:
     """Vertices ((V, 2) float, mm) and 0-based faces of an OBJ or STL file."""
     source = os.fspath(path)
     _mesh_suffix(source)
     return parse_polygons(read_bytes(source), source)
 
 
-def parse_polygons(data: bytes, source: str) -> tuple[np.ndarray, list[np.ndarray]]:
-    """Vertices and faces of OBJ or STL contents; ``source``'s suffix names the format."""
-    vertices, faces = parse_obj(_text(data), source) if _mesh_suffix(source) == ".obj" \
+def parse_polygons(data: bytes, source: str) -> tuple[np.ndarray, Loops]:
+    """Vertices and faces (a sequence of (n,) int arrays, :class:`foldcore.planar.Loops`)
+    of OBJ or STL contents; ``source``'s suffix names the format."""
+    vertices, faces = _parse_obj(data, source) if _mesh_suffix(source) == ".obj" \
         else parse_stl(data, source)
     if not faces:
         raise PatternError(f"{source}: the mesh has no faces")
@@ -170,23 +182,79 @@ def _mesh_suffix(source: str) -> str:
     return suffix
 
 
-def parse_obj(text: str, source: str) -> tuple[np.ndarray, list[np.ndarray]]:
+def parse_obj(text: str, source: str) -> tuple[np.ndarray, Loops]:
     """Vertices ((V, 2), mm) and 0-based faces of OBJ text (see module docstring)."""
-    vertices, faces, lines = [], [], []
-    for lineno, tokens in _lines(text):
-        if tokens[0] == "v":
-            vertices.append(_obj_vertex(tokens, f"{source}, line {lineno}"))
-        elif tokens[0] == "f":
-            faces.append(_obj_face(tokens, len(vertices), f"{source}, line {lineno}"))
-            lines.append(lineno)
-    n = len(vertices)
-    for f, (face, lineno) in enumerate(zip(faces, lines)):
-        bad = [v for v in face if not 0 <= v < n]
-        if bad:
-            raise PatternError(f"{source}, line {lineno}: face {f} refers to vertex "
-                               f"{bad[0] + 1}, but the file has {n} vertices (ids are 1-based)")
-    return np.array(vertices, dtype=np.float64).reshape(-1, 2), \
-        [np.array(face, dtype=np.int64) for face in faces]
+    return _parse_obj(text, source)
+
+
+def _parse_obj(data, source: str) -> tuple[np.ndarray, Loops]:
+    """:func:`parse_obj` of OBJ bytes (UTF-8; a bad byte reads as U+FFFD) or text.
+
+    The lines are read a chunk at a time into flat arrays: the coordinates, and
+    the faces' 1-based ids (negative ones resolved), lengths and line numbers.
+    A line off the plain forms goes to the one-line readers, which name its fault.
+    """
+    coords, ids, lengths, lines = array("d"), array("q"), array("q"), array("q")
+    huge: dict[int, int] = {}  # position in ids → an id beyond int64
+    lineno = 0
+    for chunk in _line_lists(data):
+        for line in chunk:
+            lineno += 1
+            tokens = (line.split("#", 1)[0] if "#" in line else line).split()
+            if not tokens:
+                continue
+            if tokens[0] == "v":
+                try:
+                    x, y = float(tokens[1]), float(tokens[2])
+                    plain = (len(tokens) < 4 or float(tokens[3]) == 0) \
+                        and math.isfinite(x) and math.isfinite(y)
+                except (ValueError, IndexError):
+                    plain = False
+                if not plain:
+                    x, y = _obj_vertex(tokens, f"{source}, line {lineno}")
+                coords.append(x)
+                coords.append(y)
+            elif tokens[0] == "f":
+                n_read = len(coords) // 2
+                try:
+                    face = [int(t) for t in tokens[1:]]
+                    plain = len(face) >= 3 and 0 not in face
+                except ValueError:
+                    plain = False
+                if not plain:
+                    face = [i + 1 for i in _obj_face(tokens, n_read, f"{source}, line {lineno}")]
+                elif min(face) < 0:
+                    face = [i if i > 0 else n_read + i + 1 for i in face]
+                mark = len(ids)
+                try:
+                    ids.extend(face)
+                except OverflowError:  # an id beyond int64 (out of range): 0 in its place
+                    del ids[mark:]
+                    fits = [-2 ** 63 <= i < 2 ** 63 for i in face]
+                    huge.update((mark + k, i) for k, i in enumerate(face) if not fits[k])
+                    ids.extend(i if fit else 0 for i, fit in zip(face, fits))
+                lengths.append(len(face))
+                lines.append(lineno)
+    return _obj_arrays(coords, ids, huge, lengths, lines, source)
+
+
+def _obj_arrays(coords: array, ids: array, huge: dict, lengths: array, lines: array,
+                source: str) -> tuple[np.ndarray, Loops]:
+    """Vertices ((V, 2)) and 0-based faces from :func:`_parse_obj`'s flat arrays;
+    PatternError naming the first face that refers to a vertex the file lacks."""
+    n = len(coords) // 2
+    flat = np.frombuffer(ids, dtype=np.int64)
+    bad = (flat < 1) | (flat > n)
+    if bad.any():
+        k = int(np.argmax(bad))
+        f = int(np.searchsorted(np.cumsum(np.frombuffer(lengths, dtype=np.int64)), k,
+                                side="right"))
+        raise PatternError(f"{source}, line {lines[f]}: face {f} refers to vertex "
+                           f"{huge.get(k, int(flat[k]))}, but the file has {n} vertices "
+                           "(ids are 1-based)")
+    faces = Loops(flat - 1, np.array(lengths, dtype=np.int64))
+    freeze(faces)  # this reader's own: the pattern shares it
+    return np.array(coords, dtype=np.float64).reshape(-1, 2), faces
 
 
 def _obj_vertex(tokens: list[str], where: str) -> tuple[float, float]:
@@ -208,7 +276,7 @@ def _obj_face(tokens: list[str], n_read: int, where: str) -> list[int]:
     return [i - 1 if i > 0 else n_read + i for i in ids]
 
 
-def parse_stl(data: bytes, source: str) -> tuple[np.ndarray, list[np.ndarray]]:
+def parse_stl(data: bytes, source: str) -> tuple[np.ndarray, Loops]:
     """Vertices ((V, 2), mm; coincident ones merged) and faces of an STL file."""
     count = int.from_bytes(data[80:84], "little")
     if len(data) >= 84 and len(data) == 84 + 50 * count:
@@ -217,7 +285,7 @@ def parse_stl(data: bytes, source: str) -> tuple[np.ndarray, list[np.ndarray]]:
     if b"\0" in data:  # ASCII STL is text: a damaged binary STL
         _bad_binary_stl(data, count, source)
     else:
-        polygons = _ascii_stl_loops(_text(data), source)
+        polygons = _ascii_stl_loops(data, source)
     return _merge_vertices(polygons)
 
 
@@ -231,10 +299,10 @@ def _bad_binary_stl(data: bytes, count: int, source: str):
                        "(truncated or damaged)")
 
 
-def _ascii_stl_loops(text: str, source: str) -> list[tuple[str, list]]:
-    """[(where, [[x, y, z], ...]), ...]: the vertex loops of an ASCII STL."""
+def _ascii_stl_loops(data, source: str) -> list[tuple[str, list]]:
+    """[(where, [[x, y, z], ...]), ...]: the vertex loops of an ASCII STL (bytes or text)."""
     loops, current = [], None
-    for lineno, tokens in _lines(text):
+    for lineno, tokens in _lines(data):
         where, word = f"{source}, line {lineno}", tokens[0].lower()
         if word == "outer":
             if current is not None:
@@ -256,7 +324,7 @@ def _ascii_stl_loops(text: str, source: str) -> list[tuple[str, list]]:
     return loops
 
 
-def _merge_triangles(tris: np.ndarray, source: str) -> tuple[np.ndarray, list[np.ndarray]]:
+def _merge_triangles(tris: np.ndarray, source: str) -> tuple[np.ndarray, Loops]:
     """:func:`_merge_vertices` of a binary STL's (F, 3, 3) facets, at once.
 
     The first vertex that is not finite with z = 0 is named as before;
@@ -282,12 +350,13 @@ def _merge_triangles(tris: np.ndarray, source: str) -> tuple[np.ndarray, list[np
     ids = np.empty(len(xy), dtype=np.int64)
     ids[order] = rank[group]
     vertices = xyz[np.sort(first), :2]
-    return np.ascontiguousarray(vertices).reshape(-1, 2), list(ids.reshape(-1, 3))
+    return np.ascontiguousarray(vertices).reshape(-1, 2), \
+        Loops(ids, np.full(len(ids) // 3, 3, dtype=np.int64))
 
 
-def _merge_vertices(polygons) -> tuple[np.ndarray, list[np.ndarray]]:
+def _merge_vertices(polygons) -> tuple[np.ndarray, Loops]:
     ids: dict[tuple[float, float], int] = {}
-    faces = []
+    flat, lengths = array("q"), array("q")
     for where, loop in polygons:
         if len(loop) < 3:
             raise PatternError(f"{where}: a facet needs at least 3 vertices, got {len(loop)}")
@@ -295,9 +364,10 @@ def _merge_vertices(polygons) -> tuple[np.ndarray, list[np.ndarray]]:
             if not (math.isfinite(x) and math.isfinite(y) and z == 0):
                 raise PatternError(f"{where}: vertex ({x:g}, {y:g}, {z:g}) must be finite "
                                    "with z = 0 (the pattern lies flat)")
-        faces.append(np.array([ids.setdefault((x, y), len(ids)) for x, y, _ in loop],
-                              dtype=np.int64))
-    return np.array(list(ids), dtype=np.float64).reshape(-1, 2), faces
+        flat.extend([ids.setdefault((x, y), len(ids)) for x, y, _ in loop])
+        lengths.append(len(loop))
+    return np.array(list(ids), dtype=np.float64).reshape(-1, 2), \
+        Loops(np.array(flat, dtype=np.int64), np.array(lengths, dtype=np.int64))
 
 
 def parse_hinges(text: str, source: str, n_edges: int) -> dict[int, tuple]:
@@ -306,34 +376,54 @@ def parse_hinges(text: str, source: str, n_edges: int) -> dict[int, tuple]:
     ``width_mm`` is NaN for ``auto``; ``angle_deg`` is signed (valley positive),
     NaN when passive. Raises PatternError naming the file and 1-based line.
     """
-    table: dict[int, tuple] = {}
-    for lineno, tokens in _lines(text):
-        where = f"{source}, line {lineno}"
-        edge, *values = _hinge_line(tokens, n_edges, where)
-        if edge in table:
-            raise PatternError(f"{where}: edge {edge} already has a hinge "
-                               f"(line {table[edge][-1]})")
-        table[edge] = (*values, lineno)
-    return table
+    rows = zip(*(column.tolist() for column in _hinge_rows(text, source, n_edges)))
+    return {row[0]: row[1:] for row in rows}
 
 
-def _hinge_line(tokens: list[str], n_edges: int, where: str) -> tuple:
+def _hinge_rows(data, source: str, n_edges: int) -> tuple[np.ndarray, ...]:
+    """The hinge lines of ``data`` (bytes or text) as arrays in line order: edge ids,
+    widths (mm, NaN: auto), kinds, signed angles (degrees, NaN: passive), max angles
+    and line numbers; PatternError naming the file and line of the first bad one."""
+    edges, lines = array("q"), array("q")
+    widths, angles, max_angles = array("d"), array("d"), array("d")
+    kinds = []
+    seen = array("q", bytes(8 * max(n_edges, 0)))  # the line of each edge's hinge
+    for lineno, tokens in _lines(data):
+        edge, width, kind, angle, max_angle = _hinge_line(tokens, n_edges, source, lineno)
+        if seen[edge]:
+            raise PatternError(f"{source}, line {lineno}: edge {edge} already has a hinge "
+                               f"(line {seen[edge]})")
+        seen[edge] = lineno
+        edges.append(edge)
+        widths.append(width)
+        kinds.append(kind)
+        angles.append(angle)
+        max_angles.append(max_angle)
+        lines.append(lineno)
+    return (np.array(edges, dtype=np.int64), np.array(widths, dtype=np.float64),
+            np.array(kinds, dtype="<U1"), np.array(angles, dtype=np.float64),
+            np.array(max_angles, dtype=np.float64), np.array(lines, dtype=np.int64))
+
+
+def _hinge_line(tokens: list[str], n_edges: int, source: str, lineno: int) -> tuple:
     if len(tokens) < 3:
-        raise PatternError(f"{where}: expected 'edge_id width M|V [bend_angle_deg]', "
-                           f"got {short(' '.join(tokens))}")
+        raise PatternError(f"{source}, line {lineno}: expected 'edge_id width M|V "
+                           f"[bend_angle_deg]', got {short(' '.join(tokens))}")
     edge = _int(tokens[0])
     if edge is None or not 0 <= edge < n_edges:
-        raise PatternError(f"{where}: edge id {tokens[0]!r} is not an edge of the mesh "
-                           f"(ids 0..{n_edges - 1}; see foldcore.io.mesh_edges)")
+        raise PatternError(f"{source}, line {lineno}: edge id {tokens[0]!r} is not an edge of "
+                           f"the mesh (ids 0..{n_edges - 1}; see foldcore.io.mesh_edges)")
     width = math.nan if tokens[1].lower() == "auto" else _float(tokens[1])
     if width is None or width <= 0:
-        raise PatternError(f"{where}: width {tokens[1]!r} must be a positive number "
-                           "(mm) or 'auto'")
+        raise PatternError(f"{source}, line {lineno}: width {tokens[1]!r} must be a positive "
+                           "number (mm) or 'auto'")
     kind = tokens[2].upper()
     if kind not in HINGE_KINDS:
-        raise PatternError(f"{where}: hinge kind {tokens[2]!r} must be one of "
+        raise PatternError(f"{source}, line {lineno}: hinge kind {tokens[2]!r} must be one of "
                            f"{', '.join(HINGE_KINDS)}")
-    return (edge, width, kind, *_hinge_options(tokens[3:], kind, where))
+    if len(tokens) == 3:
+        return edge, width, kind, math.nan, DEFAULT_MAX_ANGLE_DEG
+    return (edge, width, kind, *_hinge_options(tokens[3:], kind, f"{source}, line {lineno}"))
 
 
 def _hinge_options(tokens: list[str], kind: str, where: str) -> tuple[float, float]:
@@ -373,47 +463,80 @@ def pattern_from_mesh(vertices, faces, hinges: dict, source: str) -> CreasePatte
     source : str
         Name used in error messages.
     """
+    rows = list(zip(*((e, *values) for e, values in hinges.items()))) or [()] * 6
+    columns = tuple(np.array(c, dtype=t) for c, t in zip(rows, (np.int64, np.float64, "<U1",
+                                                               np.float64, np.float64, np.int64)))
     edges, counts = _edge_table(faces)
-    n = len(edges)
+    values = _edge_values(vertices, counts, columns, source)
+    return build_pattern(dict(vertices=vertices, edges=edges, faces=faces, source=source,
+                              **values))
+
+
+def _edge_values(vertices, counts, hinges: tuple, source: str) -> dict:
+    """The per-edge arguments of the pattern (assignments, angles, widths, max angles)
+    from the faces on each edge (``counts``, :func:`_edge_table`) and the hinges as
+    :func:`_hinge_rows` columns, checked in line order, as the lines were read."""
+    n = len(counts)
     for e in np.flatnonzero(counts > 2):
         raise PatternError(f"{source}: edge {e} is shared by {counts[e]} faces (at most 2)")
-    _check_widths(vertices, hinges, source)
+    edge, width, kind, angle, max_angle, line = hinges
+    _check_widths(vertices, edge, width, line, source)
+    for k in np.flatnonzero(counts[edge] == 1)[:1]:
+        raise PatternError(f"{source}, hinge line {line[k]}: edge {edge[k]} is on the sheet "
+                           "boundary (one face); only interior edges take hinges")
     kinds = np.where(counts == 1, "B", "?")
     angles, widths = np.full(n, np.nan), np.full(n, np.nan)
     max_angles = np.full(n, DEFAULT_MAX_ANGLE_DEG)
-    for e, (width, kind, angle, max_angle, lineno) in hinges.items():
-        if counts[e] == 1:
-            raise PatternError(f"{source}, hinge line {lineno}: edge {e} is on the sheet "
-                               "boundary (one face); only interior edges take hinges")
-        kinds[e], widths[e], angles[e], max_angles[e] = kind, width, angle, max_angle
+    kinds[edge], widths[edge], angles[edge], max_angles[edge] = kind, width, angle, max_angle
     missing = np.flatnonzero(kinds == "?")
     if len(missing):
         raise PatternError(f"{source}: interior edge {missing[0]} has no hinge line "
                            f"({len(missing)} missing); every interior edge needs one, since "
                            "the panels are the mesh faces")
-    return build_pattern(dict(vertices=vertices, edges=edges, assignments=kinds,
-                              fold_angles=angles, widths=widths, max_angles=max_angles,
-                              faces=faces, source=source))
+    return dict(assignments=kinds, fold_angles=angles, widths=widths, max_angles=max_angles)
 
 
-def _check_widths(vertices, hinges: dict, source: str) -> None:
-    """Each given hinge width within :data:`foldcore.limits.WIDTH_RATIO` of the sheet."""
-    for e, (width, *_, lineno) in hinges.items():
-        if not math.isnan(width):
-            limits.check_width(width, vertices, f"width of edge {e}",
-                                f"{source}, hinge line {lineno}")
+def _check_widths(vertices, edge, width, line, source: str) -> None:
+    """Each given hinge width (not NaN) within :data:`foldcore.limits.WIDTH_RATIO` of the
+    sheet, at once; the first one outside is named by :func:`foldcore.limits.check_width`."""
+    given = np.flatnonzero(~np.isnan(width))
+    extent = limits.sheet_extent(vertices) if len(given) else 0.0
+    if not limits.LENGTH_MM[0] <= extent <= limits.LENGTH_MM[1]:
+        return  # check_width skips them: the pattern names the extent
+    lo, hi = limits.length_window(limits.WIDTH_RATIO, extent)
+    w = width[given]
+    for k in given[~(np.isfinite(w) & (lo <= w) & (w <= hi))][:1]:
+        limits.check_width(float(width[k]), vertices, f"width of edge {edge[k]}",
+                           f"{source}, hinge line {line[k]}")
 
 
-def _lines(text: str):
-    """(1-based line number, tokens) of each non-blank line, ``#`` comments removed."""
-    for lineno, line in enumerate(text.split("\n"), 1):
-        tokens = line.split("#", 1)[0].split()
-        if tokens:
-            yield lineno, tokens
+def _line_lists(data):
+    """The lines of ``data`` — bytes (UTF-8, a bad byte read as U+FFFD) or text — as
+    ``text.split("\\n")`` gives them, in lists of about :data:`CHUNK_CHARS` characters."""
+    newline = "\n" if isinstance(data, str) else b"\n"
+    start, size = 0, len(data)
+    while start < size:
+        cut = data.find(newline, start + CHUNK_CHARS)
+        end = size if cut < 0 else cut + 1
+        piece = data[start:end]
+        text = piece if isinstance(piece, str) else piece.decode("utf-8", errors="replace")
+        lines = text.split("\n")
+        if text.endswith("\n"):
+            lines.pop()  # the end of this piece, not a line
+        yield lines
+        start = end
 
 
-def _text(data: bytes) -> str:
-    return data.decode("utf-8", errors="replace")
+def _lines(data):
+    """(1-based line number, tokens) of each non-blank line of ``data`` (bytes or text,
+    :func:`_line_lists`), ``#`` comments removed."""
+    lineno = 0
+    for lines in _line_lists(data):
+        for line in lines:
+            lineno += 1
+            tokens = line.split("#", 1)[0].split()
+            if tokens:
+                yield lineno, tokens
 
 
 def _float(token: str) -> float | None:
@@ -452,7 +575,7 @@ def write_hinges(path, pattern: CreasePattern) -> None:
     with files.atomic_write(path) as fh:
         fh.write("# foldcore hinge file: edge_id width(mm|auto) M|V|F|U [angle_deg] "
                  "[max=deg]\n# edge ids: unique face sides in order of first appearance\n")
-        for i, (a, b) in enumerate(mesh_edges(pattern.faces).tolist()):
+        for i, (a, b) in enumerate(mesh_edges(pattern.face_loops).tolist()):
             e = lookup[(min(a, b), max(a, b))]
             if pattern.assignments[e] != "B":
                 fh.write(f"{i} {_hinge_fields(pattern, e)}\n")
