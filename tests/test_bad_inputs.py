@@ -56,3 +56,76 @@ def test_a_bow_tie_is_refused_when_read_under_every_solver(tmp_path, out):
                         "-o", out / "o.fold", "--report", out / "r.json")
         refused(proc, f"{path}: vertex 0: faces meet only at this vertex (a bow-tie)")
     nothing_written(out)
+
+
+# ------------------------------------------------------------ numbers out of range
+def _capped():
+    """At most 4 GB of address space in the child: a run that is not refused fails
+    there, not on the machine."""
+    import resource
+
+    resource.setrlimit(resource.RLIMIT_AS, (4 << 30, 4 << 30))
+
+
+OPTIONS = {  # name: (options, what the line says)
+    "cells_denormal": (["--elastic-cells", "5e-324"],
+                       ["hinge.fold: --elastic-cells = 4.94066e-324 mm is outside the accepted "
+                        "0.001 … 1e+05 mm"]),
+    "cells_tiny": (["--elastic-cells", "1e-300"], ["--elastic-cells = 1e-300 mm is outside"]),
+    "sub_strips": (["--subdivisions", "1000000"],
+                   ["argument --subdivisions: expected an integer in 1..64 or 'auto'"]),
+    "tolerance": (["--tolerance", "1e300"], ["--tolerance must be in [1e-15, 0.01], got 1e+300"]),
+    "tolerance_loose": (["--tolerance", "0.1"], ["--tolerance must be in [1e-15, 0.01]"]),
+    "budget": (["--max-iterations", "2000000"],
+               ["--max-iterations must be an integer in 1..1000000, got 2000000"]),
+    "ground": (["--ground", "1e300"], ["hinge.fold: --ground = 1e+300 mm is outside the "
+                                       "accepted ±1e+05 mm"]),
+    "thickness": (["--thickness", "1e300"], ["hinge.fold: --thickness = 1e+300 mm"]),
+    "sheet_size": (["--sheet-size", "1e8"], ["hinge.fold: the sheet is 1e+08 mm across"]),
+    "fold_percent": (["--fold-percent", "1e300"], ["--fold-percent must be in [-100, 100]"]),
+}
+
+
+@pytest.mark.parametrize("name", sorted(OPTIONS))
+def test_an_option_out_of_its_range_is_refused_before_the_run(name, hinge_file, out):
+    options, needles = OPTIONS[name]
+    proc = subprocess.run([sys.executable, "-m", "foldcore", "simulate", str(hinge_file),
+                           *options, "-o", str(out / "o.fold"), "--report", str(out / "r.json")],
+                          capture_output=True, text=True, timeout=300, preexec_fn=_capped)
+    refused(proc, *needles)
+    nothing_written(out)
+
+
+def test_too_many_elastic_cells_are_refused_before_the_mesh_is_built(tmp_path, out):
+    """A Miura 10 × 10 (210 mm) in 0.0315 mm cells, inside the cells' own window: the
+    estimate, 767 000 vertices in cells, is refused before any cell is made."""
+    from foldcore import patterns
+    from foldcore.io import write_fold
+
+    path = tmp_path / "miura.fold"
+    write_fold(path, patterns.miura(10, 10), thickness=1.0)
+    proc = subprocess.run([sys.executable, "-m", "foldcore", "simulate", str(path),
+                           "--elastic-cells", "0.0315", "-o", str(out / "o.fold")],
+                          capture_output=True, text=True, timeout=300, preexec_fn=_capped)
+    refused(proc, f"{path}: the elastic cells would have about 7.67e+05 vertices, more than "
+                  "the 5e+05 accepted")
+    nothing_written(out)
+
+
+def test_svg_stroke_and_margin_are_bounded(hinge_file, tmp_path, out):
+    result = tmp_path / "result.fold"
+    assert foldcore("simulate", hinge_file, "-o", result, "--max-iterations", "20").returncode == 0
+    for option, needle in (("--stroke-width", "SVG stroke width = 1e+300 mm is outside"),
+                           ("--margin", "SVG margin = 1e+300 mm is outside the accepted 0 … "
+                                        "100 mm")):
+        proc = foldcore("export", result, "--svg", out / "sheet.svg", option, "1e300")
+        refused(proc, f"{result}: {needle}")
+    nothing_written(out)
+
+
+def test_the_help_gives_each_range():
+    text = " ".join(foldcore("simulate", "--help").stdout.split())
+    for needle in ("1..64", "1e-15 … 0.01", "1 … 1,000,000", "0.0001 … 10000 × the sheet's "
+                   "extent", "1e-06 … 10000 × the sheet's extent", "10,000,000 vertices",
+                   "2..10000", "(0, 100]", "0 … 180"):
+        assert needle in text, needle

@@ -32,6 +32,9 @@ import warnings
 from .hinges import DEFAULT_HINGE, HINGE_MODELS
 from .actuation import ACTUATIONS, BRANCH_FLOOR_DEG, DEFAULT_ACTUATION
 from .destinations import check_destinations
+from .limits import (CELL_RATIO, GROUND_RATIO, LENGTH_MM, MARGIN_RATIO, MAX_ELASTIC_VERTICES,
+                     MAX_ITERATIONS, MAX_MESH_VERTICES, STROKE_RATIO, SUBDIVISIONS,
+                     THICKNESS_RATIO, TOLERANCE, WIDTH_RATIO)
 from .options import CONTACT_CHOICES, MAX_FPS, MAX_FRAMES
 from .strategies import DEFAULT_SOLVER, SOLVERS
 
@@ -50,12 +53,14 @@ class _Parser(argparse.ArgumentParser):
 def _subdivisions(text: str):
     if text == "auto":
         return "auto"
+    lo, hi = SUBDIVISIONS
     try:
         value = int(text)
     except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a positive integer or 'auto', got {text!r}")
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"expected a positive integer or 'auto', got {value}")
+        value = None
+    if value is None or not lo <= value <= hi:
+        raise argparse.ArgumentTypeError(f"expected an integer in {lo}..{hi} or 'auto', "
+                                         f"got {text!r}")
     return value
 
 
@@ -109,10 +114,11 @@ def _fps(text: str) -> float:
 def _add_rebuild_options(parser) -> None:
     """Options of render/export that rebuild the thick mesh of a result file."""
     parser.add_argument("--hinge-width", type=_positive,
-                        help="hinge width W in mm given to simulate (default: the file's widths)")
+                        help="hinge width W in mm given to simulate (default: the file's widths)"
+                             f"; {WIDTH_RATIO[0]:g} … {WIDTH_RATIO[1]:g} × the sheet's extent")
     parser.add_argument("--subdivisions", type=_subdivisions, default=None,
-                        help="sub-strips per hinge given to simulate (default: found from "
-                             "the folded frame)")
+                        help=f"sub-strips per hinge given to simulate, {SUBDIVISIONS[0]}.."
+                             f"{SUBDIVISIONS[1]} (default: found from the folded frame)")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -163,24 +169,34 @@ def _add_reading(sim) -> None:
     size = sim.add_mutually_exclusive_group()
     size.add_argument("--scale", type=_positive, metavar="FACTOR",
                       help="multiply every length of the pattern file (after its "
-                           "frame_unit) by FACTOR")
+                           "frame_unit) by FACTOR; the sheet's larger extent must then be "
+                           f"{LENGTH_MM[0]:g} … {LENGTH_MM[1]:g} mm, as every length")
     size.add_argument("--sheet-size", type=_positive, metavar="MM",
-                      help="scale the pattern so that its larger extent is MM millimetres "
-                           "(a unit-square file is otherwise 1 mm wide)")
+                      help="scale the pattern so that its larger extent is MM millimetres, "
+                           f"{LENGTH_MM[0]:g} … {LENGTH_MM[1]:g} (a unit-square file is "
+                           "otherwise 1 mm wide)")
 
 
 def _add_thickening(sim) -> None:
+    extent = "× the sheet's extent"
     sim.add_argument("--thickness", type=_positive,
-                     help="sheet thickness H in mm (default: the file's foldcore:thickness)")
+                     help="sheet thickness H in mm (default: the file's foldcore:thickness), "
+                          f"{THICKNESS_RATIO[0]:g} … {THICKNESS_RATIO[1]:g} {extent}")
     sim.add_argument("--hinge-width", type=_positive,
                      help="hinge width W in mm for every crease (default: the file's widths, "
-                          "else Eq. 7 with r = 0)")
+                          f"else Eq. 7 with r = 0), {WIDTH_RATIO[0]:g} … {WIDTH_RATIO[1]:g} "
+                          f"{extent}")
     sim.add_argument("--subdivisions", type=_subdivisions, default="auto",
-                     help="sub-strips per hinge, or 'auto' (default)")
+                     help=f"sub-strips per hinge, {SUBDIVISIONS[0]}..{SUBDIVISIONS[1]}, or "
+                          "'auto' (default: 2..16 from each hinge's largest angle)")
     sim.add_argument("--elastic-cells", type=_positive, metavar="MM",
                      help="elastic panels: cut every face into rings of cells about MM mm "
                           "long, so panels bend and stretch where the targets ask for it "
-                          "(non-rigidly-foldable patterns); default: rigid panels")
+                          "(non-rigidly-foldable patterns), MM "
+                          f"{CELL_RATIO[0]:g} … {CELL_RATIO[1]:g} {extent}; default: rigid "
+                          f"panels. A thick mesh may have {MAX_MESH_VERTICES:,} vertices, "
+                          f"{MAX_ELASTIC_VERTICES:,} of them in elastic cells (checked before "
+                          "it is built)")
     sim.add_argument("--hinge", choices=HINGE_MODELS,
                      help="hinge model of every crease: axis (panels turn about the crease, "
                           "rigid-origami kinematics at any thickness), arc (the paper's "
@@ -203,8 +219,11 @@ def _add_solving(sim) -> None:
                           "same map accelerated)")
     sim.add_argument("--tolerance", type=_positive, default=1e-8,
                      help="stop when the state is this × the pattern size from its "
-                          "equilibrium (default 1e-8)")
-    sim.add_argument("--max-iterations", type=int, default=10_000)
+                          f"equilibrium, {TOLERANCE[0]:g} … {TOLERANCE[1]:g} (default 1e-8): "
+                          "looser, a run reads converged degrees short of it; tighter, float64 "
+                          "cannot resolve it")
+    sim.add_argument("--max-iterations", type=int, default=10_000,
+                     help=f"iteration budget, 1 … {MAX_ITERATIONS:,} (default 10,000)")
     sim.add_argument("--actuation", choices=ACTUATIONS, default=DEFAULT_ACTUATION,
                      help="equal (an actuated hinge weighs what a passive one does, the "
                           "paper's) or angle (actuated hinges 1000x stiffer: their angles are "
@@ -212,8 +231,9 @@ def _add_solving(sim) -> None:
     sim.add_argument("--branch-floor", type=_non_negative, default=BRANCH_FLOOR_DEG,
                      metavar="DEG",
                      help="from a flat sheet, first fold with passive M/V creases held at "
-                          "least DEG degrees on their assigned side, then release them "
-                          f"(branch selection; 0 turns it off; default {BRANCH_FLOOR_DEG:g})")
+                          "least DEG degrees (0 … 180) on their assigned side, then release "
+                          "them (branch selection; 0 turns it off; default "
+                          f"{BRANCH_FLOOR_DEG:g})")
     sim.add_argument("--contact", choices=CONTACT_CHOICES, default="off",
                      help="on: panels no crease joins never pass through each other (IPC "
                           "barrier and collision-checked steps; solvers hybrid, rigid, "
@@ -226,7 +246,8 @@ def _add_solving(sim) -> None:
                           "on")
     sim.add_argument("--ground", type=float, default=None, metavar="Z",
                      help="a horizontal plane at height Z mm, facing up, the sheet never "
-                          "passes (the flat sheet's bottom face is at -H/2); turns contact on")
+                          "passes (the flat sheet's bottom face is at -H/2; |Z| at most "
+                          f"{GROUND_RATIO:g} × the sheet's extent); turns contact on")
 
 
 def _add_outputs(sim) -> None:
@@ -242,10 +263,10 @@ def _add_outputs(sim) -> None:
                      help="also write the fold from 0 to --fold-percent as one FOLD file, a "
                           "frame per fold percent (achieved angles and the folded solid)")
     sim.add_argument("--frames", type=_frames, default=20,
-                     help="frames of --animate / --series, fold percents evenly from 0 "
-                          "(default 20)")
+                     help="frames of --animate / --series, fold percents evenly from 0, "
+                          f"2..{MAX_FRAMES} (default 20)")
     sim.add_argument("--fps", type=_fps, default=10.0,
-                     help="animation frames per second (default 10)")
+                     help=f"animation frames per second, (0, {MAX_FPS:g}] (default 10)")
 
 
 def _add_render(sub) -> None:
@@ -271,10 +292,11 @@ def _add_export(sub) -> None:
     exp.add_argument("--dxf", help="flat sheet outlines as DXF (mm; needs the 'export' extra)")
     exp.add_argument("--stl", help="folded solid as binary STL (mm)")
     exp.add_argument("--stroke-width", type=_positive, metavar="MM",
-                     help="SVG stroke width in mm (default: 1/1000 of the sheet, at most "
-                          "0.1 mm)")
+                     help=f"SVG stroke width in mm, {STROKE_RATIO[0]:g} … {STROKE_RATIO[1]:g} × "
+                          "the sheet's extent (default: 1/1000 of the sheet, at most 0.1 mm)")
     exp.add_argument("--margin", type=_non_negative, metavar="MM",
-                     help="SVG margin around the sheet in mm (default: 2%% of the sheet)")
+                     help=f"SVG margin around the sheet in mm, {MARGIN_RATIO[0]:g} … "
+                          f"{MARGIN_RATIO[1]:g} × its extent (default: 2%% of the sheet)")
     _add_rebuild_options(exp)
 
 

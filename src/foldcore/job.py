@@ -157,7 +157,8 @@ def _prepared(job: Job):
 
     t = job.thickening
     loaded = read_file(job.source, hinges=job.hinges, reading=job.reading)
-    check_inputs(loaded.pattern, t.thickness, t.hinge_width, loaded.stiffness)
+    check_inputs(loaded.pattern, t.thickness, t.hinge_width, loaded.stiffness,
+                 t.elastic_cells, job.solving.ground)
     thickness = t.thickness or loaded.thickness
     if thickness is None:
         raise OptionError(f"{job.source}: no thickness: give thickening.thickness (mm) "
