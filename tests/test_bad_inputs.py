@@ -7,6 +7,7 @@ exit code and stderr are the real ones.
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 import sys
 
@@ -129,3 +130,47 @@ def test_the_help_gives_each_range():
                    "extent", "1e-06 … 10000 × the sheet's extent", "10,000,000 vertices",
                    "2..10000", "(0, 100]", "0 … 180"):
         assert needle in text, needle
+
+
+# ------------------------------------------------------------ inputs that are not files
+needs_fifo = pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="needs named pipes")
+
+
+def _fifo(path):
+    os.mkfifo(path)
+    return path
+
+
+@needs_fifo
+@pytest.mark.parametrize("case", ["fold", "svg", "hinges", "obstacle", "render", "export",
+                                  "view", "device"])
+def test_an_input_that_is_not_a_regular_file_is_refused_before_it_is_opened(
+        case, hinge_file, tmp_path, out):
+    """A named pipe blocked the read forever (no writer comes); a device never ends."""
+    from foldcore import patterns
+    from foldcore.io import write_obj
+
+    folder = tmp_path / "in"
+    folder.mkdir()
+    if case == "hinges":
+        write_obj(folder / "mesh.obj", patterns.single_hinge(width=2.0))
+    pipe = {"fold": "p.fold", "svg": "p.svg", "hinges": "mesh.hinges", "obstacle": "wall.stl",
+            "render": "r.fold", "export": "r.fold", "view": "r.fold"}.get(case)
+    bad = _fifo(folder / pipe) if pipe else folder / "zero.fold"
+    if case == "device":
+        if not os.path.exists("/dev/zero"):
+            pytest.skip("no /dev/zero")
+        bad.symlink_to("/dev/zero")
+    args = {"fold": ["simulate", bad, "-o", out / "o.fold"],
+            "svg": ["simulate", bad, "--thickness", "1", "-o", out / "o.fold"],
+            "hinges": ["simulate", folder / "mesh.obj", "--hinges", bad, "--thickness", "1",
+                       "-o", out / "o.fold"],
+            "obstacle": ["simulate", hinge_file, "--obstacle", bad, "-o", out / "o.fold"],
+            "render": ["render", bad, "-o", out / "o.png"],
+            "export": ["export", bad, "--stl", out / "o.stl"],
+            "view": ["view", bad, "-o", out / "o.html"],
+            "device": ["simulate", bad, "-o", out / "o.fold"]}[case]
+    kind = "a character device" if case == "device" else "a named pipe (FIFO)"
+    refused(foldcore(*args, timeout=120), f"{bad}: cannot read the file: it is {kind}, not a "
+                                          "regular file")
+    nothing_written(out)
