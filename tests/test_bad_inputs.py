@@ -14,9 +14,9 @@ import sys
 import pytest
 
 
-def foldcore(*args, timeout: float = 300) -> subprocess.CompletedProcess:
+def foldcore(*args, timeout: float = 300, cwd=None) -> subprocess.CompletedProcess:
     return subprocess.run([sys.executable, "-m", "foldcore", *map(str, args)],
-                          capture_output=True, text=True, timeout=timeout)
+                          capture_output=True, text=True, timeout=timeout, cwd=cwd)
 
 
 def refused(proc: subprocess.CompletedProcess, *needles: str) -> str:
@@ -173,4 +173,39 @@ def test_an_input_that_is_not_a_regular_file_is_refused_before_it_is_opened(
     kind = "a character device" if case == "device" else "a named pipe (FIFO)"
     refused(foldcore(*args, timeout=120), f"{bad}: cannot read the file: it is {kind}, not a "
                                           "regular file")
+    nothing_written(out)
+
+
+# ------------------------------------------------------------------ output names
+@pytest.mark.parametrize("args", [["simulate", "{hinge}", "-o", ""],
+                                  ["simulate", "{hinge}", "--report", ""],
+                                  ["view", "{result}", "-o", ""],
+                                  ["render", "{result}", "-o", ""],
+                                  ["export", "{result}", "--svg", "", "--stl", "x.stl"]],
+                         ids=["fold", "report", "view", "render", "export"])
+def test_an_empty_output_name_is_refused(args, hinge_file, out):
+    """``-o ""`` ran the fold, wrote nothing and exited 0."""
+    result = out.parent / "result.fold"
+    if "{result}" in args:
+        assert foldcore("simulate", hinge_file, "-o", result,
+                        "--max-iterations", "20").returncode == 0
+    args = [a.format(hinge=hinge_file, result=result) for a in args]
+    option = args[args.index("") - 1]
+    refused(foldcore(*args, cwd=out), f'{option} "": the file name is empty')
+    nothing_written(out)
+
+
+def test_an_empty_scene_folder_is_refused(out):
+    refused(foldcore("scene", "miura", "--quick", "--out", "", cwd=out),
+            "--out '': output folder does not exist")
+    nothing_written(out)
+
+
+def test_a_file_name_longer_than_the_folder_takes_is_refused_before_the_run(hinge_file, out):
+    """A 305-byte name failed only when the result was written, after the run."""
+    name = "a" * 300 + ".fold"
+    proc = foldcore("simulate", hinge_file, "-o", out / name, "--report", out / "r.json")
+    limit = os.pathconf(out, "PC_NAME_MAX")
+    refused(proc, f"-o {out / name}: the file name is 305 bytes, longer than the {limit} "
+                  "this system takes")
     nothing_written(out)

@@ -325,8 +325,8 @@ def run_scene(args) -> int:
     from . import scenes
     from .errors import FoldcoreError
 
-    if not Path(args.out).is_dir():
-        raise FoldcoreError(f"{args.out}: output folder does not exist")
+    if not args.out or not Path(args.out).is_dir():  # ("" would be the current folder)
+        raise FoldcoreError(f"{args.out or '--out ' + repr('')}: output folder does not exist")
     run = scenes.run(args.name, quick=args.quick, solver=args.solver,
                      contact=None if args.contact is None else args.contact == "on")
     for path in scenes.write(run, args.out, png=args.render):
