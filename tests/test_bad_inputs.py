@@ -209,3 +209,106 @@ def test_a_file_name_longer_than_the_folder_takes_is_refused_before_the_run(hing
     refused(proc, f"-o {out / name}: the file name is 305 bytes, longer than the {limit} "
                   "this system takes")
     nothing_written(out)
+
+
+# ------------------------------------------------------------------ early signals
+SIGNAL_AT_IMPORT = """
+import os, signal, sys
+class SignalAt:
+    def find_spec(self, name, path, target=None):
+        if name == {module!r}:
+            os.kill(os.getpid(), signal.{signal})
+        return None
+sys.meta_path.insert(0, SignalAt())
+sys.argv = ["foldcore", "simulate", {pattern!r}, "-o", {out!r}]
+from foldcore.__main__ import run
+sys.exit(run())
+"""
+
+
+@pytest.mark.parametrize("module", ["foldcore.cli", "foldcore.scenes"],
+                         ids=["starting", "parsing"])
+@pytest.mark.parametrize("name, code", [("SIGINT", 130), ("SIGTERM", 143)])
+def test_a_signal_while_the_command_starts_is_one_line(module, name, code, hinge_file, out):
+    """The signal arrives while the command line is imported (before main runs) or
+    while it parses the arguments (whose parser imports most of the package): it was
+    a KeyboardInterrupt traceback, or for SIGTERM an exit by the signal (−15) saying
+    nothing."""
+    script = SIGNAL_AT_IMPORT.format(module=module, signal=name, pattern=str(hinge_file),
+                                     out=str(out / "o.fold"))
+    proc = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                          timeout=300)
+    assert proc.returncode == code, (proc.returncode, proc.stderr)
+    assert "Traceback" not in proc.stderr
+    (line,) = proc.stderr.splitlines()
+    what = "interrupted (SIGINT)" if name == "SIGINT" else "terminated (SIGTERM)"
+    assert line.startswith(f"foldcore: {what}"), line
+    nothing_written(out)
+
+
+def test_a_signal_after_the_command_leaves_its_exit_code(tmp_path):
+    """Once main has returned the work is done: a signal while the interpreter shuts
+    down does not change the exit code (it ended the process by the signal)."""
+    script = ("import os, signal, sys, time\n"
+              "from foldcore import __main__, cli\n"
+              "cli.main = lambda argv=None: 0\n"
+              "code = __main__.run()\n"
+              "os.kill(os.getpid(), signal.SIGTERM)\n"
+              "time.sleep(0.5)\n"
+              "sys.exit(code)\n")
+    proc = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                          timeout=300)
+    assert proc.returncode == 0 and proc.stderr == "", (proc.returncode, proc.stderr)
+
+
+def test_a_signal_lost_in_a_callback_from_c_is_sent_again():
+    """A handler's exception inside a ctypes callback is printed ("Exception ignored")
+    and dropped by ctypes; llvmlite calls one while numba compiles: the signal comes
+    back 10 ms later in Python code, silently."""
+    script = ("import ctypes, os, signal, time\n"
+              "from foldcore import interrupts\n"
+              "def callback():\n"
+              "    os.kill(os.getpid(), signal.SIGTERM)\n"
+              "    for _ in range(1000): pass\n"
+              "lost = ctypes.CFUNCTYPE(None)(callback)\n"
+              "with interrupts.handled():\n"
+              "    try:\n"
+              "        lost()\n"
+              "        time.sleep(5)\n"
+              "        print('lost')\n"
+              "    except interrupts.Terminated:\n"
+              "        print('raised')\n")
+    proc = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                          timeout=300)
+    assert proc.stdout.split() == ["raised"] and proc.stderr == "", proc
+
+
+def test_a_signal_that_code_turned_into_another_error_is_still_the_signal():
+    """numpy's import turns an exception raised inside it into an ImportError: the
+    command still ends as the signal says."""
+    import signal
+
+    from foldcore import interrupts
+
+    with interrupts.handled():
+        try:
+            try:
+                os.kill(os.getpid(), signal.SIGTERM)
+                for _ in range(10**6):
+                    pass
+            except interrupts.Terminated as exc:
+                raise ImportError("C-extensions failed") from exc
+        except ImportError as exc:
+            assert interrupts.caught(exc) == (143, "terminated (SIGTERM)")
+    assert interrupts.caught(ImportError("no signal since")) is None
+
+
+def test_the_console_script_is_the_entry_that_handles_signals_first():
+    import tomllib
+    from pathlib import Path
+
+    from foldcore import __main__
+
+    project = tomllib.loads((Path(__file__).parents[1] / "pyproject.toml").read_text())
+    assert project["project"]["scripts"]["foldcore"] == "foldcore.__main__:run"
+    assert callable(__main__.run)

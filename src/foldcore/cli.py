@@ -26,12 +26,14 @@ import logging
 import math
 import re
 import sys
-import threading
 import warnings
 
 from .hinges import DEFAULT_HINGE, HINGE_MODELS
 from .actuation import ACTUATIONS, BRANCH_FLOOR_DEG, DEFAULT_ACTUATION
 from .destinations import check_destinations
+from .errors import FoldcoreError
+from . import interrupts
+from .interrupts import EXIT_SIGINT
 from .limits import (CELL_RATIO, GROUND_RATIO, LENGTH_MM, MARGIN_RATIO, MAX_ELASTIC_VERTICES,
                      MAX_ITERATIONS, MAX_MESH_VERTICES, STROKE_RATIO, SUBDIVISIONS,
                      THICKNESS_RATIO, TOLERANCE, WIDTH_RATIO)
@@ -39,8 +41,6 @@ from .options import CONTACT_CHOICES, MAX_FPS, MAX_FRAMES
 from .strategies import DEFAULT_SOLVER, SOLVERS
 
 EXIT_BAD_INPUT = 2
-EXIT_SIGINT = 130  # 128 + SIGINT, as shells report it
-EXIT_SIGTERM = 143  # 128 + SIGTERM
 
 
 class _Parser(argparse.ArgumentParser):
@@ -323,7 +323,6 @@ def run_scene(args) -> int:
     from pathlib import Path
 
     from . import scenes
-    from .errors import FoldcoreError
 
     if not args.out or not Path(args.out).is_dir():  # ("" would be the current folder)
         raise FoldcoreError(f"{args.out or '--out ' + repr('')}: output folder does not exist")
@@ -503,15 +502,6 @@ COMMANDS = {"simulate": simulate, "render": render_result, "export": export_resu
             "view": view_result, "scene": run_scene}
 
 
-class Terminated(BaseException):
-    """SIGTERM, raised where the process is, so temporary files are removed on the way
-    out (a BaseException: nothing catches it by accident)."""
-
-
-def _terminate(signum, frame):
-    raise Terminated()
-
-
 def _warning_lines(caught) -> list[str]:
     """One line per kind of warning, in order of first appearance: the first message
     and how many more like it (the same text up to its numbers) followed."""
@@ -531,44 +521,43 @@ def main(argv=None) -> int:
 
     Warnings are printed one line per kind, with a count, after the command
     succeeds; a refusal prints only its own line. SIGINT and SIGTERM end the
-    command with one line and exit codes 130 and 143; files not yet complete
-    are not written (their temporary files are removed,
+    command with one line and exit codes 130 and 143, from the first statement
+    on (parsing the arguments imports most of the package; :mod:`foldcore.interrupts`);
+    files not yet complete are not written (their temporary files are removed,
     :mod:`foldcore.destinations`).
     """
-    import signal
+    with interrupts.handled():
+        return _main(argv)
 
-    from .errors import FoldcoreError
 
+def _main(argv) -> int:
+    """:func:`main` under its signal handlers."""
+    args = handler = None
     try:
         args = build_parser().parse_args(argv)
-    except SystemExit as exc:  # usage error (already reported) or --help
-        return exc.code
-    in_main_thread = threading.current_thread() is threading.main_thread()
-    previous = signal.signal(signal.SIGTERM, _terminate) if in_main_thread else None
-    handler = _log_to_stderr(args.verbose)
-    try:
+        handler = _log_to_stderr(args.verbose)
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
+            warnings.simplefilter("ignore", ResourceWarning)  # (a file an interrupt left open)
             code = COMMANDS[args.command](args)
         for line in _warning_lines(caught):
             print(line, file=sys.stderr)
         return code
+    except SystemExit as exc:  # usage error (already reported) or --help
+        return exc.code
     except FoldcoreError as exc:
         print(f"foldcore: error: {in_flags(str(exc))}", file=sys.stderr)
     except OSError as exc:
         name = exc.filename or getattr(args, "pattern", None) or getattr(args, "result", "")
         print(f"foldcore: error: {name}: {exc.strerror or exc}", file=sys.stderr)
-    except KeyboardInterrupt:
-        print("foldcore: interrupted (SIGINT); files not yet complete were not written",
+    except BaseException as exc:  # a signal, or what code it passed through made of it
+        signalled = interrupts.caught(exc)
+        if signalled is None:
+            raise
+        print(f"foldcore: {signalled[1]}; files not yet complete were not written",
               file=sys.stderr)
-        return EXIT_SIGINT
-    except Terminated:
-        print("foldcore: terminated (SIGTERM); files not yet complete were not written",
-              file=sys.stderr)
-        return EXIT_SIGTERM
+        return signalled[0]
     finally:
-        if in_main_thread:
-            signal.signal(signal.SIGTERM, previous)
         if handler is not None:
             logging.getLogger("foldcore").removeHandler(handler)
     return EXIT_BAD_INPUT

@@ -5,8 +5,8 @@ folder; only when it returns without an exception is the temporary file
 fsynced (open files) and renamed over the destination, so a reader never sees
 a half-written file and an error leaves the old file as it was. Any exception
 removes the temporary file, including ``KeyboardInterrupt`` and the exception
-the command line raises for SIGTERM (:func:`foldcore.cli.main`), so Ctrl-C or
-a kill leaves nothing behind; SIGKILL cannot be caught and may leave a
+the command line raises for SIGTERM (:class:`foldcore.interrupts.Terminated`), so
+Ctrl-C or a kill leaves nothing behind; SIGKILL cannot be caught and may leave a
 ``.NAME.PID.HEX.tmp`` file. :func:`all_or_nothing` extends this to several
 files: none is renamed until every writer has succeeded.
 
