@@ -276,7 +276,8 @@ def _add_render(sub) -> None:
     ren.add_argument("--view", default="iso", choices=("iso", "top", "side", "front"),
                      help="camera: iso (default), top, side (from +x), front (from -y)")
     ren.add_argument("--size", type=_size, default=(1024, 768),
-                     help="picture size WIDTHxHEIGHT in pixels (default 1024x768)")
+                     help="picture size WIDTHxHEIGHT in pixels, each 16..8192 (default "
+                          "1024x768)")
     ren.add_argument("--color-by", default="none",
                      choices=("angle", "strip-angle", "strain", "none"),
                      help="hinge colours: mountain/valley (none, default), each crease's fold "
@@ -326,6 +327,7 @@ def run_scene(args) -> int:
 
     if not args.out or not Path(args.out).is_dir():  # ("" would be the current folder)
         raise FoldcoreError(f"{args.out or '--out ' + repr('')}: output folder does not exist")
+    check_destinations({"--out": Path(args.out) / f"{args.name}.fold"})  # writable, before
     run = scenes.run(args.name, quick=args.quick, solver=args.solver,
                      contact=None if args.contact is None else args.contact == "on")
     for path in scenes.write(run, args.out, png=args.render):
