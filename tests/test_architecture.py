@@ -159,7 +159,8 @@ def test_the_import_graph_has_no_cycle():
 #: The layers of the run, top to bottom: a module never imports (lazily included) one
 #: of a layer above its own. The data side (pattern, thick mesh, readers) is below all.
 LAYERS = [
-    ("foldcore.cli", "foldcore.demo", "foldcore.warmup", "foldcore.__main__"),
+    ("foldcore.cli", "foldcore.demo", "foldcore.warmup", "foldcore.__main__",
+     "foldcore.interrupts"),
     ("foldcore.job", "foldcore.scenes"),
     ("foldcore.animate", "foldcore.view", "foldcore.outputs", "foldcore.render",
      "foldcore.fabrication", "foldcore.destinations", "foldcore.result_file",

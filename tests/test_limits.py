@@ -146,3 +146,122 @@ def test_corners_of_the_window_fold_to_the_target(name):
     assert np.isfinite(result.positions).all()
     assert result.converged and abs(result.fold_angles_deg[0] - 90.0) < 0.01
 
+
+
+# ------------------------------------------------------------ counts and run options
+def _hinge():
+    return patterns.single_hinge(panel_length=5.0, depth=2.0, angle=90.0, width=2.0)
+
+
+@pytest.fixture
+def memory_cap():
+    """At most 2 GB more address space while the test runs: a mesh that is not refused
+    fails with MemoryError, not on the machine."""
+    resource = pytest.importorskip("resource")
+    soft, hard = resource.getrlimit(resource.RLIMIT_AS)
+    try:
+        with open("/proc/self/status") as fh:
+            size = next(int(line.split()[1]) * 1024 for line in fh if line.startswith("VmSize:"))
+    except (OSError, StopIteration):  # no /proc: run uncapped
+        yield
+        return
+    cap = size + (2 << 30)
+    resource.setrlimit(resource.RLIMIT_AS, (cap if hard == resource.RLIM_INFINITY
+                                            else min(cap, hard), hard))
+    yield
+    resource.setrlimit(resource.RLIMIT_AS, (soft, hard))
+
+
+@pytest.mark.parametrize("cells", [5e-324, 1e-300])
+def test_a_cell_count_too_large_for_an_integer_is_refused_before_any_cell(cells, memory_cap):
+    """5e-324 mm cells made ⌈length / size⌉ infinite: OverflowError; 1e-300 mm grew
+    memory without end."""
+    from foldcore.errors import MeshError
+
+    with pytest.raises(MeshError, match=r"^single_hinge: elastic (facet|plate) on face 0: .*"
+                                        r"more than the 1e\+07 vertices"):
+        thicken(_hinge(), 1.0, subdivisions=4, elastic="facets", cell_size=cells)
+    with pytest.raises(MeshError, match="elastic plate on face 0"):
+        thicken(_hinge(), 1.0, subdivisions=4, elastic="plates", cell_size=cells)
+
+
+def test_the_mesh_size_is_bounded_before_the_mesh_is_built(monkeypatch, memory_cap):
+    from foldcore.errors import MeshError
+
+    with pytest.raises(MeshError, match=r"the elastic cells would have about 3.2e\+07 "
+                                        r"vertices, more than the 5e\+05 accepted"):
+        thicken(_hinge(), 1.0, subdivisions=4, elastic="plates", cell_size=1e-3)
+    monkeypatch.setattr(limits, "MAX_MESH_VERTICES", 100)
+    with pytest.raises(MeshError, match=r"^single_hinge: the thick mesh would have about "
+                                        r"\d+ vertices, more than the 100 accepted"):
+        thicken(_hinge(), 1.0, subdivisions=64)
+    assert thicken(_hinge(), 1.0, subdivisions=4).n_vertices < 100
+
+
+@pytest.mark.parametrize("k", [0, 65, 10**6])
+def test_given_sub_strips_are_within_their_range(k, memory_cap):
+    from foldcore.errors import MeshError
+
+    with pytest.raises(MeshError, match=r"subdivisions must be integers in 1\.\.64"):
+        thicken(_hinge(), 1.0, subdivisions=k)
+    assert thicken(_hinge(), 1.0, subdivisions=limits.SUBDIVISIONS[1]).n_vertices > 0
+
+
+@pytest.mark.parametrize("make, options", [
+    (_hinge, {"subdivisions": 4}),
+    (_hinge, {"subdivisions": 4, "elastic": "facets", "cell_size": 0.5}),
+    (_hinge, {"subdivisions": 4, "elastic": "plates", "cell_size": 0.5}),
+    (_hinge, {"subdivisions": 4, "elastic": {0: "auto", 1: "auto"}, "cell_size": 0.5}),
+    (lambda: patterns.miura(6, 6), {"hinge_width": 2.0, "subdivisions": 2}),
+    (lambda: patterns.miura(4, 4), {"hinge_width": 2.0, "subdivisions": 2, "elastic": "facets",
+                                    "cell_size": 1.0}),
+    (lambda: patterns.miura(4, 4), {"hinge_width": 2.0, "subdivisions": 2, "elastic": "plates",
+                                    "cell_size": 1.0}),
+])
+def test_the_mesh_size_estimate_is_near_the_count_built(make, options, monkeypatch):
+    """The estimate the bound is checked against: at least the count built and at most
+    1.5 × it (a Miura 400 × 400, the largest benchmark, stays inside the bound)."""
+    from foldcore.thickening import build
+
+    estimates = []
+    estimate = build.mesh_vertices
+    monkeypatch.setattr(build, "mesh_vertices",
+                        lambda *a: estimates.append(estimate(*a)) or estimates[-1])
+    mesh = thicken(make(), 1.0, **options)
+    total, elastic = estimates[0]
+    assert mesh.n_vertices <= total <= 1.5 * mesh.n_vertices
+    assert (elastic > 0) == bool(mesh.elastic)
+
+
+def test_the_tolerance_is_bounded_where_a_verdict_still_means_something():
+    """Above 1e-2 × the size a run is called converged degrees short (1e300: an
+    OverflowError in the rigid-body stopping rule); 0 still runs the whole budget."""
+    from foldcore.errors import SimulationError
+    from foldcore.options import OptionError, Solving
+
+    pattern = _hinge()
+    sim = Simulation(thicken(pattern, 1.0, subdivisions=4), pattern)
+    for tolerance in (1e300, 0.1, -1.0, float("nan")):
+        with pytest.raises(SimulationError, match=r"^single_hinge: tolerance must be in "
+                                                  r"\[0, 0.01\]"):
+            sim.run(tolerance=tolerance, max_iterations=5)
+    assert sim.run(tolerance=0, max_iterations=3).iterations == 3
+    for tolerance in (1e300, 0.011, 1e-16, 0.0):
+        with pytest.raises(OptionError, match=r"solving.tolerance must be in \[1e-15, 0.01\]"):
+            Solving(tolerance=tolerance)
+    with pytest.raises(OptionError, match=r"solving.max_iterations must be an integer in "
+                                          r"1\.\.1000000"):
+        Solving(max_iterations=limits.MAX_ITERATIONS + 1)
+    Solving(tolerance=1e-2, max_iterations=limits.MAX_ITERATIONS)  # the corners are accepted
+
+
+def test_elastic_cells_and_ground_are_checked_against_the_sheet(scene):
+    """Both in mm, against the sheet's extent (10 mm): named as the options."""
+    pattern = _hinge()
+    limits.check_inputs(pattern, elastic_cells=1e-3, ground=-1e5)  # the window's corners
+    with pytest.raises(PatternError, match=r"thickening.elastic_cells = 0.0009 mm is outside "
+                                           r"the accepted 0.001 … 1e\+05 mm"):
+        limits.check_inputs(pattern, elastic_cells=9e-4)
+    with pytest.raises(PatternError, match=r"solving.ground = 1e\+300 mm is outside the "
+                                           r"accepted ±1e\+05 mm"):
+        limits.check_inputs(pattern, ground=1e300)

@@ -399,3 +399,39 @@ def test_face_too_short():
 def test_overlapping_faces():
     # the same face twice
     refused("face", 1, faces=[[0, 4, 5, 3], [0, 4, 5, 3]])
+
+
+# Two triangles sharing vertex 0 only (a bow-tie), and two creased squares pinned at
+# vertex 0: connected as a graph, but not one sheet joined along edges.
+BOWTIE_V = [(0, 0), (10, 0), (10, 10), (-10, 0), (-10, -10)]
+BOWTIE_E = [(0, 1), (1, 2), (2, 0), (0, 3), (3, 4), (4, 0)]
+PINNED_V = [(0, 0), (10, 0), (10, 10), (0, 10), (-10, 0), (-10, -10), (0, -10)]
+PINNED_E = [(0, 1), (1, 2), (2, 3), (3, 0), (1, 3), (0, 4), (4, 5), (5, 6), (6, 0), (4, 6)]
+PINNED_A = ["B", "B", "B", "B", "V", "B", "B", "B", "B", "V"]
+
+
+@pytest.mark.parametrize("faces", [[[0, 1, 2], [0, 3, 4]], None], ids=["given", "derived"])
+def test_faces_meeting_only_at_a_vertex_are_refused_naming_it(faces):
+    msg = refused("vertex", 0, vertices=BOWTIE_V, edges=BOWTIE_E, assignments=["B"] * 6,
+                  faces=faces)
+    assert "bow-tie" in msg and "simulate each piece on its own" in msg
+
+
+def test_creased_pieces_pinned_at_a_vertex_are_refused_naming_it():
+    msg = refused("vertex", 0, vertices=PINNED_V, edges=PINNED_E, assignments=PINNED_A)
+    assert "faces meet only at this vertex" in msg
+
+
+def test_separate_pieces_are_refused_like_a_bow_tie():
+    """Two pieces apart and two pieces at one vertex: both one line, the same advice."""
+    vertices = PINNED_V[:4] + [(x + 30.0, y) for x, y in PINNED_V[4:]] + [(30.0, 0.0)]
+    edges = [(7 if (u == 0 and i >= 5) else u, 7 if (v == 0 and i >= 5) else v)
+             for i, (u, v) in enumerate(PINNED_E)]
+    msg = refused("vertex", 4, vertices=vertices, edges=edges, assignments=PINNED_A)
+    assert "not connected (2 separate pieces)" in msg and "simulate each piece on its own" in msg
+
+
+def test_a_boundary_vertex_with_one_fan_is_one_sheet():
+    """Vertex 4 of the two squares has two faces and one crease between them; vertex 0
+    one face: each a single fan."""
+    assert len(make(faces=SQ_F).faces) == 2

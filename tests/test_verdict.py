@@ -53,7 +53,7 @@ def test_a_budget_that_ends_is_not_convergence():
     pattern, mesh, creases, expected = thin_miura(1e-3)
     sim = Simulation(mesh, pattern, solver="rigid")
     assert not sim.run(tolerance=1e-8, max_iterations=3).converged
-    assert not sim.run(tolerance=1.0, max_iterations=0).converged
+    assert not sim.run(tolerance=1e-2, max_iterations=0).converged  # the loosest accepted
 
 
 def hinge_to_90(h_over_size: float):

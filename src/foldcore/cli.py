@@ -26,18 +26,21 @@ import logging
 import math
 import re
 import sys
-import threading
 import warnings
 
 from .hinges import DEFAULT_HINGE, HINGE_MODELS
 from .actuation import ACTUATIONS, BRANCH_FLOOR_DEG, DEFAULT_ACTUATION
 from .destinations import check_destinations
+from .errors import FoldcoreError
+from . import interrupts
+from .interrupts import EXIT_SIGINT
+from .limits import (CELL_RATIO, GROUND_RATIO, LENGTH_MM, MARGIN_RATIO, MAX_ELASTIC_VERTICES,
+                     MAX_ITERATIONS, MAX_MESH_VERTICES, STROKE_RATIO, SUBDIVISIONS,
+                     THICKNESS_RATIO, TOLERANCE, WIDTH_RATIO)
 from .options import CONTACT_CHOICES, MAX_FPS, MAX_FRAMES
 from .strategies import DEFAULT_SOLVER, SOLVERS
 
 EXIT_BAD_INPUT = 2
-EXIT_SIGINT = 130  # 128 + SIGINT, as shells report it
-EXIT_SIGTERM = 143  # 128 + SIGTERM
 
 
 class _Parser(argparse.ArgumentParser):
@@ -50,12 +53,14 @@ class _Parser(argparse.ArgumentParser):
 def _subdivisions(text: str):
     if text == "auto":
         return "auto"
+    lo, hi = SUBDIVISIONS
     try:
         value = int(text)
     except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a positive integer or 'auto', got {text!r}")
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"expected a positive integer or 'auto', got {value}")
+        value = None
+    if value is None or not lo <= value <= hi:
+        raise argparse.ArgumentTypeError(f"expected an integer in {lo}..{hi} or 'auto', "
+                                         f"got {text!r}")
     return value
 
 
@@ -109,10 +114,11 @@ def _fps(text: str) -> float:
 def _add_rebuild_options(parser) -> None:
     """Options of render/export that rebuild the thick mesh of a result file."""
     parser.add_argument("--hinge-width", type=_positive,
-                        help="hinge width W in mm given to simulate (default: the file's widths)")
+                        help="hinge width W in mm given to simulate (default: the file's widths)"
+                             f"; {WIDTH_RATIO[0]:g} … {WIDTH_RATIO[1]:g} × the sheet's extent")
     parser.add_argument("--subdivisions", type=_subdivisions, default=None,
-                        help="sub-strips per hinge given to simulate (default: found from "
-                             "the folded frame)")
+                        help=f"sub-strips per hinge given to simulate, {SUBDIVISIONS[0]}.."
+                             f"{SUBDIVISIONS[1]} (default: found from the folded frame)")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -163,24 +169,34 @@ def _add_reading(sim) -> None:
     size = sim.add_mutually_exclusive_group()
     size.add_argument("--scale", type=_positive, metavar="FACTOR",
                       help="multiply every length of the pattern file (after its "
-                           "frame_unit) by FACTOR")
+                           "frame_unit) by FACTOR; the sheet's larger extent must then be "
+                           f"{LENGTH_MM[0]:g} … {LENGTH_MM[1]:g} mm, as every length")
     size.add_argument("--sheet-size", type=_positive, metavar="MM",
-                      help="scale the pattern so that its larger extent is MM millimetres "
-                           "(a unit-square file is otherwise 1 mm wide)")
+                      help="scale the pattern so that its larger extent is MM millimetres, "
+                           f"{LENGTH_MM[0]:g} … {LENGTH_MM[1]:g} (a unit-square file is "
+                           "otherwise 1 mm wide)")
 
 
 def _add_thickening(sim) -> None:
+    extent = "× the sheet's extent"
     sim.add_argument("--thickness", type=_positive,
-                     help="sheet thickness H in mm (default: the file's foldcore:thickness)")
+                     help="sheet thickness H in mm (default: the file's foldcore:thickness), "
+                          f"{THICKNESS_RATIO[0]:g} … {THICKNESS_RATIO[1]:g} {extent}")
     sim.add_argument("--hinge-width", type=_positive,
                      help="hinge width W in mm for every crease (default: the file's widths, "
-                          "else Eq. 7 with r = 0)")
+                          f"else Eq. 7 with r = 0), {WIDTH_RATIO[0]:g} … {WIDTH_RATIO[1]:g} "
+                          f"{extent}")
     sim.add_argument("--subdivisions", type=_subdivisions, default="auto",
-                     help="sub-strips per hinge, or 'auto' (default)")
+                     help=f"sub-strips per hinge, {SUBDIVISIONS[0]}..{SUBDIVISIONS[1]}, or "
+                          "'auto' (default: 2..16 from each hinge's largest angle)")
     sim.add_argument("--elastic-cells", type=_positive, metavar="MM",
                      help="elastic panels: cut every face into rings of cells about MM mm "
                           "long, so panels bend and stretch where the targets ask for it "
-                          "(non-rigidly-foldable patterns); default: rigid panels")
+                          "(non-rigidly-foldable patterns), MM "
+                          f"{CELL_RATIO[0]:g} … {CELL_RATIO[1]:g} {extent}; default: rigid "
+                          f"panels. A thick mesh may have {MAX_MESH_VERTICES:,} vertices, "
+                          f"{MAX_ELASTIC_VERTICES:,} of them in elastic cells (checked before "
+                          "it is built)")
     sim.add_argument("--hinge", choices=HINGE_MODELS,
                      help="hinge model of every crease: axis (panels turn about the crease, "
                           "rigid-origami kinematics at any thickness), arc (the paper's "
@@ -203,8 +219,11 @@ def _add_solving(sim) -> None:
                           "same map accelerated)")
     sim.add_argument("--tolerance", type=_positive, default=1e-8,
                      help="stop when the state is this × the pattern size from its "
-                          "equilibrium (default 1e-8)")
-    sim.add_argument("--max-iterations", type=int, default=10_000)
+                          f"equilibrium, {TOLERANCE[0]:g} … {TOLERANCE[1]:g} (default 1e-8): "
+                          "looser, a run reads converged degrees short of it; tighter, float64 "
+                          "cannot resolve it")
+    sim.add_argument("--max-iterations", type=int, default=10_000,
+                     help=f"iteration budget, 1 … {MAX_ITERATIONS:,} (default 10,000)")
     sim.add_argument("--actuation", choices=ACTUATIONS, default=DEFAULT_ACTUATION,
                      help="equal (an actuated hinge weighs what a passive one does, the "
                           "paper's) or angle (actuated hinges 1000x stiffer: their angles are "
@@ -212,8 +231,9 @@ def _add_solving(sim) -> None:
     sim.add_argument("--branch-floor", type=_non_negative, default=BRANCH_FLOOR_DEG,
                      metavar="DEG",
                      help="from a flat sheet, first fold with passive M/V creases held at "
-                          "least DEG degrees on their assigned side, then release them "
-                          f"(branch selection; 0 turns it off; default {BRANCH_FLOOR_DEG:g})")
+                          "least DEG degrees (0 … 180) on their assigned side, then release "
+                          "them (branch selection; 0 turns it off; default "
+                          f"{BRANCH_FLOOR_DEG:g})")
     sim.add_argument("--contact", choices=CONTACT_CHOICES, default="off",
                      help="on: panels no crease joins never pass through each other (IPC "
                           "barrier and collision-checked steps; solvers hybrid, rigid, "
@@ -226,7 +246,8 @@ def _add_solving(sim) -> None:
                           "on")
     sim.add_argument("--ground", type=float, default=None, metavar="Z",
                      help="a horizontal plane at height Z mm, facing up, the sheet never "
-                          "passes (the flat sheet's bottom face is at -H/2); turns contact on")
+                          "passes (the flat sheet's bottom face is at -H/2; |Z| at most "
+                          f"{GROUND_RATIO:g} × the sheet's extent); turns contact on")
 
 
 def _add_outputs(sim) -> None:
@@ -242,10 +263,10 @@ def _add_outputs(sim) -> None:
                      help="also write the fold from 0 to --fold-percent as one FOLD file, a "
                           "frame per fold percent (achieved angles and the folded solid)")
     sim.add_argument("--frames", type=_frames, default=20,
-                     help="frames of --animate / --series, fold percents evenly from 0 "
-                          "(default 20)")
+                     help="frames of --animate / --series, fold percents evenly from 0, "
+                          f"2..{MAX_FRAMES} (default 20)")
     sim.add_argument("--fps", type=_fps, default=10.0,
-                     help="animation frames per second (default 10)")
+                     help=f"animation frames per second, (0, {MAX_FPS:g}] (default 10)")
 
 
 def _add_render(sub) -> None:
@@ -255,7 +276,8 @@ def _add_render(sub) -> None:
     ren.add_argument("--view", default="iso", choices=("iso", "top", "side", "front"),
                      help="camera: iso (default), top, side (from +x), front (from -y)")
     ren.add_argument("--size", type=_size, default=(1024, 768),
-                     help="picture size WIDTHxHEIGHT in pixels (default 1024x768)")
+                     help="picture size WIDTHxHEIGHT in pixels, each 16..8192 (default "
+                          "1024x768)")
     ren.add_argument("--color-by", default="none",
                      choices=("angle", "strip-angle", "strain", "none"),
                      help="hinge colours: mountain/valley (none, default), each crease's fold "
@@ -271,10 +293,11 @@ def _add_export(sub) -> None:
     exp.add_argument("--dxf", help="flat sheet outlines as DXF (mm; needs the 'export' extra)")
     exp.add_argument("--stl", help="folded solid as binary STL (mm)")
     exp.add_argument("--stroke-width", type=_positive, metavar="MM",
-                     help="SVG stroke width in mm (default: 1/1000 of the sheet, at most "
-                          "0.1 mm)")
+                     help=f"SVG stroke width in mm, {STROKE_RATIO[0]:g} … {STROKE_RATIO[1]:g} × "
+                          "the sheet's extent (default: 1/1000 of the sheet, at most 0.1 mm)")
     exp.add_argument("--margin", type=_non_negative, metavar="MM",
-                     help="SVG margin around the sheet in mm (default: 2%% of the sheet)")
+                     help=f"SVG margin around the sheet in mm, {MARGIN_RATIO[0]:g} … "
+                          f"{MARGIN_RATIO[1]:g} × its extent (default: 2%% of the sheet)")
     _add_rebuild_options(exp)
 
 
@@ -301,10 +324,10 @@ def run_scene(args) -> int:
     from pathlib import Path
 
     from . import scenes
-    from .errors import FoldcoreError
 
-    if not Path(args.out).is_dir():
-        raise FoldcoreError(f"{args.out}: output folder does not exist")
+    if not args.out or not Path(args.out).is_dir():  # ("" would be the current folder)
+        raise FoldcoreError(f"{args.out or '--out ' + repr('')}: output folder does not exist")
+    check_destinations({"--out": Path(args.out) / f"{args.name}.fold"})  # writable, before
     run = scenes.run(args.name, quick=args.quick, solver=args.solver,
                      contact=None if args.contact is None else args.contact == "on")
     for path in scenes.write(run, args.out, png=args.render):
@@ -487,15 +510,6 @@ COMMANDS = {"simulate": simulate, "render": render_result, "export": export_resu
             "view": view_result, "scene": run_scene}
 
 
-class Terminated(BaseException):
-    """SIGTERM, raised where the process is, so temporary files are removed on the way
-    out (a BaseException: nothing catches it by accident)."""
-
-
-def _terminate(signum, frame):
-    raise Terminated()
-
-
 def _say_warnings(caught: list) -> None:
     """Print the warnings caught so far (:func:`_warning_lines`) and forget them."""
     for line in _warning_lines(caught):
@@ -522,48 +536,48 @@ def main(argv=None) -> int:
 
     Warnings are printed one line per kind, with a count, after the command
     succeeds; a refusal prints only its own line. SIGINT and SIGTERM end the
-    command with one line and exit codes 130 and 143; files not yet complete
-    are not written (their temporary files are removed,
+    command with one line and exit codes 130 and 143, from the first statement
+    on (parsing the arguments imports most of the package; :mod:`foldcore.interrupts`);
+    files not yet complete are not written (their temporary files are removed,
     :mod:`foldcore.destinations`).
     """
-    import signal
+    with interrupts.handled():
+        return _main(argv)
 
-    from .errors import FoldcoreError
 
+def _main(argv) -> int:
+    """:func:`main` under its signal handlers."""
+    args = handler = None
     try:
         args = build_parser().parse_args(argv)
-    except SystemExit as exc:  # usage error (already reported) or --help
-        return exc.code
-    in_main_thread = threading.current_thread() is threading.main_thread()
-    previous = signal.signal(signal.SIGTERM, _terminate) if in_main_thread else None
-    handler = _log_to_stderr(args.verbose)
-    try:
+        handler = _log_to_stderr(args.verbose)
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
+            warnings.simplefilter("ignore", ResourceWarning)  # (a file an interrupt left open)
             args.say_warnings = lambda: _say_warnings(caught)  # before a long run, too
             code = COMMANDS[args.command](args)
         _say_warnings(caught)
         return code
+    except SystemExit as exc:  # usage error (already reported) or --help
+        return exc.code
     except FoldcoreError as exc:
         print(f"foldcore: error: {in_flags(str(exc))}", file=sys.stderr)
     except OSError as exc:
         name = exc.filename or getattr(args, "pattern", None) or getattr(args, "result", "")
         print(f"foldcore: error: {name}: {exc.strerror or exc}", file=sys.stderr)
     except MemoryError:
-        name = getattr(args, "pattern", None) or getattr(args, "result", "") or args.command
+        name = getattr(args, "pattern", None) or getattr(args, "result", None) \
+            or getattr(args, "command", "foldcore")
         print(f"foldcore: error: {name}: out of memory (a smaller file, fewer cells or "
               "sub-strips, or more memory)", file=sys.stderr)
-    except KeyboardInterrupt:
-        print("foldcore: interrupted (SIGINT); files not yet complete were not written",
+    except BaseException as exc:  # a signal, or what code it passed through made of it
+        signalled = interrupts.caught(exc)
+        if signalled is None:
+            raise
+        print(f"foldcore: {signalled[1]}; files not yet complete were not written",
               file=sys.stderr)
-        return EXIT_SIGINT
-    except Terminated:
-        print("foldcore: terminated (SIGTERM); files not yet complete were not written",
-              file=sys.stderr)
-        return EXIT_SIGTERM
+        return signalled[0]
     finally:
-        if in_main_thread:
-            signal.signal(signal.SIGTERM, previous)
         if handler is not None:
             logging.getLogger("foldcore").removeHandler(handler)
     return EXIT_BAD_INPUT

@@ -20,7 +20,9 @@ def check_destinations(outputs: dict, inputs=(), suffixes: dict | None = None) -
     Parameters
     ----------
     outputs : dict {option name: path or None}
-        e.g. ``{"-o": "out.fold", "--report": None}``; None entries are skipped.
+        e.g. ``{"-o": "out.fold", "--report": None}``; None entries are skipped, an
+        empty name is refused, and so is a name longer than its folder takes
+        (``NAME_MAX``, ``PATH_MAX``: found now rather than after the run).
     inputs : iterable of paths
         Files the command reads: an output may not overwrite one.
     suffixes : dict {option name: tuple of suffixes}, optional
@@ -34,8 +36,10 @@ def check_destinations(outputs: dict, inputs=(), suffixes: dict | None = None) -
     """
     seen = {}
     for option, path in outputs.items():
-        if not path:
+        if path is None:
             continue
+        if not os.fspath(path):
+            raise OutputError(f'{option} "": the file name is empty; name the file to write')
         target = os.path.realpath(os.fspath(path))
         folder = os.path.dirname(target)
         where = f"{option} {os.fspath(path)}"
@@ -49,6 +53,7 @@ def check_destinations(outputs: dict, inputs=(), suffixes: dict | None = None) -
             raise OutputError(f"{where}: cannot write there (no such folder: {folder})")
         if not os.access(folder, os.W_OK):
             raise OutputError(f"{where}: cannot write there (folder not writable: {folder})")
+        _check_length(target, folder, where)
         for source in inputs:
             if source and os.path.realpath(os.fspath(source)) == target:
                 raise OutputError(f"{where}: is the input file {os.fspath(source)}; "
@@ -56,3 +61,19 @@ def check_destinations(outputs: dict, inputs=(), suffixes: dict | None = None) -
         if target in seen:
             raise OutputError(f"{where}: also given to {seen[target]}")
         seen[target] = option
+
+
+def _check_length(target: str, folder: str, where: str) -> None:
+    """OutputError naming ``where`` when ``target``'s file name (bytes) is longer than
+    its ``folder`` takes, or the whole path longer than the system's limit."""
+    for what, text, name, default in (("file name", os.path.basename(target), "PC_NAME_MAX",
+                                       255),
+                                      ("path", target, "PC_PATH_MAX", 4096)):
+        try:
+            limit = os.pathconf(folder, name)
+        except (OSError, ValueError, AttributeError):  # not known here: the usual
+            limit = default
+        size = len(os.fsencode(text))
+        if limit is not None and limit > 0 and size > limit:
+            raise OutputError(f"{where}: the {what} is {size} bytes, longer than the {limit} "
+                              "this system takes")

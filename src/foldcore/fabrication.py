@@ -35,7 +35,7 @@ import io
 
 import numpy as np
 
-from . import files
+from . import files, limits
 from .files import ExportError
 from .result_file import ResultFile
 from .surface import stl_bytes
@@ -240,10 +240,13 @@ def export(result: ResultFile, svg=None, dxf=None, stl=None, stroke_mm: float | 
     stl : path, optional
         The folded solid at ``result.positions``.
     stroke_mm, margin_mm : float, optional
-        SVG stroke width and margin, mm (default: shares of the sheet's extent).
+        SVG stroke width and margin, mm (default: shares of the sheet's extent);
+        1e-6 … 1 and 0 … 10 × the sheet's extent (:data:`foldcore.limits.STROKE_RATIO`,
+        :data:`foldcore.limits.MARGIN_RATIO`).
     """
     if not (svg or dxf or stl):
         raise ExportError("nothing to export: give svg, dxf and/or stl paths")
+    limits.check_svg_sizes(stroke_mm, margin_mm, result.pattern.vertices, result.source)
     for path in (svg, dxf, stl):
         if path:
             files.check_folder(path, ExportError)  # every destination before any write

@@ -5,10 +5,14 @@ folder; only when it returns without an exception is the temporary file
 fsynced (open files) and renamed over the destination, so a reader never sees
 a half-written file and an error leaves the old file as it was. Any exception
 removes the temporary file, including ``KeyboardInterrupt`` and the exception
-the command line raises for SIGTERM (:func:`foldcore.cli.main`), so Ctrl-C or
-a kill leaves nothing behind; SIGKILL cannot be caught and may leave a
+the command line raises for SIGTERM (:class:`foldcore.interrupts.Terminated`), so
+Ctrl-C or a kill leaves nothing behind; SIGKILL cannot be caught and may leave a
 ``.NAME.PID.HEX.tmp`` file. :func:`all_or_nothing` extends this to several
 files: none is renamed until every writer has succeeded.
+
+Every file foldcore reads is first checked here too (:func:`check_input`): a
+named pipe, a device or a folder is refused before it is opened, where a
+read would block forever or never end.
 
 Design notes: ``docs/architecture.md#output-files-one-module-writes-them-all``.
 """
@@ -17,6 +21,7 @@ from __future__ import annotations
 import errno
 import os
 import secrets
+import stat
 from contextlib import ExitStack, contextmanager, suppress
 
 from .errors import FoldcoreError
@@ -33,6 +38,34 @@ class OutputError(FoldcoreError, ValueError):
 
 class ExportError(FoldcoreError, ValueError):
     """A fabrication file cannot be made (bad geometry, missing package, no output)."""
+
+
+class InputError(FoldcoreError, ValueError):
+    """An input path is not a regular file that can be read."""
+
+
+#: What a path that is not a regular file is, by its ``stat`` mode.
+_KINDS = ((stat.S_ISDIR, "a folder"), (stat.S_ISFIFO, "a named pipe (FIFO)"),
+          (stat.S_ISCHR, "a character device"), (stat.S_ISBLK, "a block device"),
+          (stat.S_ISSOCK, "a socket"))
+
+
+def check_input(path, error: type = InputError) -> os.stat_result:
+    """The ``stat`` of an input path that is a regular file (symbolic links followed);
+    ``error`` (a :class:`~foldcore.errors.FoldcoreError`) naming ``path`` otherwise:
+    missing or unreadable, or a folder, a named pipe (whose read blocks until a
+    writer comes), a device or a socket, refused before it is opened."""
+    source = os.fspath(path)
+    try:
+        info = os.stat(source)
+    except OSError as exc:
+        raise error(f"{source}: cannot read the file ({exc.strerror or exc})") from None
+    except ValueError as exc:  # e.g. a NUL byte in the path
+        raise error(f"{source}: cannot read the file (invalid path: {exc})") from None
+    if not stat.S_ISREG(info.st_mode):
+        kind = next((name for test, name in _KINDS if test(info.st_mode)), "not a file")
+        raise error(f"{source}: cannot read the file: it is {kind}, not a regular file")
+    return info
 
 
 def check_folder(path, error: type = OutputError) -> None:

@@ -187,16 +187,20 @@ def _prepared(job: Job):
     """The pattern read and its thickness (mm), every output path checked: all that can
     fail on the inputs fails here, before any work."""
     from .destinations import check_destinations
+    from .files import check_input
     from .io import read_file
     from .limits import check_inputs
 
     t = job.thickening
     loaded = read_file(job.source, hinges=job.hinges, reading=job.reading)
-    check_inputs(loaded.pattern, t.thickness, t.hinge_width, loaded.stiffness)
+    check_inputs(loaded.pattern, t.thickness, t.hinge_width, loaded.stiffness,
+                 t.elastic_cells, job.solving.ground)
     thickness = t.thickness or loaded.thickness
     if thickness is None:
         raise OptionError(f"{job.source}: no thickness: give thickening.thickness (mm) "
                           "or set foldcore:thickness in the file")
+    for path in job.solving.obstacles:  # read after thickening: checked now
+        check_input(path)
     check_destinations(job.outputs.paths(), inputs=(job.source, job.hinges),
                        suffixes={"outputs.render": (".png",), "outputs.series": (".fold",)})
     if job.outputs.animate:  # (an animation interrupted writes nothing: its frames are a sweep)

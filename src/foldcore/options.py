@@ -16,6 +16,7 @@ from dataclasses import dataclass, fields
 from .actuation import ACTUATIONS, BRANCH_FLOOR_DEG, DEFAULT_ACTUATION
 from .errors import FoldcoreError
 from .hinges import HINGE_MODELS
+from .limits import MAX_ITERATIONS, SUBDIVISIONS, TOLERANCE
 from .strategies import DEFAULT_SOLVER
 
 MAX_FRAMES = 10_000
@@ -60,12 +61,19 @@ class Thickening:
     hinge_width : float, optional
         Hinge width W of every crease, mm (default: the file's, else Eq. 7).
     subdivisions : int or "auto"
-        Sub-strips per hinge.
+        Sub-strips per hinge, in 1..64 (:data:`foldcore.limits.SUBDIVISIONS`), or
+        ``"auto"`` (2 … 16 from the hinge's largest angle).
     hinge : {"axis", "arc", "eq8", "slack"}, optional
         Hinge model of every crease (default: the file's, else axis).
     elastic_cells : float, optional
         Elastic panels: every face cut into rings of cells about this long, mm
-        (default: rigid panels).
+        (default: rigid panels); 1e-4 … 1e4 × the sheet's extent
+        (:data:`foldcore.limits.CELL_RATIO`, checked once the pattern is read).
+
+    Thickness, hinge width and cell length are checked against the sheet's
+    extent once the pattern is read (:func:`foldcore.limits.check_inputs`), and
+    the thick mesh's vertex count against
+    :data:`foldcore.limits.MAX_MESH_VERTICES` before it is built.
     """
 
     thickness: float | None = None
@@ -79,7 +87,7 @@ class Thickening:
         _positive(self.hinge_width, "thickening.hinge_width")
         _positive(self.elastic_cells, "thickening.elastic_cells")
         if self.subdivisions != "auto":
-            _count(self.subdivisions, 1, None, "thickening.subdivisions")
+            _count(self.subdivisions, *SUBDIVISIONS, "thickening.subdivisions")
         if self.hinge is not None and self.hinge not in HINGE_MODELS:
             raise OptionError(f"thickening.hinge must be one of {', '.join(HINGE_MODELS)}, "
                               f"got {self.hinge!r}")
@@ -96,9 +104,14 @@ class Solving:
     solver : str
         Iteration strategy (``foldcore.strategies``), default ``"hybrid"``.
     tolerance : float
-        Relative stopping threshold (× the pattern's size).
+        Relative stopping threshold (× the pattern's size), in [1e-15, 1e-2]
+        (:data:`foldcore.limits.TOLERANCE`): the run ends converged when its state is
+        within tolerance × size of the equilibrium, so a looser one reads
+        "converged" degrees short of it, and a tighter one cannot be resolved in
+        float64.
     max_iterations : int
-        Iteration budget of the run (of each frame of a sweep).
+        Iteration budget of the run (of each frame of a sweep), in 1..1 000 000
+        (:data:`foldcore.limits.MAX_ITERATIONS`).
     actuation : {"equal", "angle"}
     branch_floor : float
         Degrees ≥ 0 passive M/V creases are held on their assigned side while a
@@ -115,7 +128,9 @@ class Solving:
         mid-surface is z = 0) of fixed obstacles the sheet touches but never passes.
     ground : float, optional
         Height z (mm) of a horizontal plane facing up that the sheet never passes
-        (below −H/2: the flat sheet's bottom face).
+        (below −H/2: the flat sheet's bottom face); |z| at most 1e4 × the sheet's
+        extent (:data:`foldcore.limits.GROUND_RATIO`, checked once the pattern is
+        read).
     """
 
     fold_percent: float = 100.0
@@ -148,8 +163,8 @@ class Solving:
             raise OptionError(f"solving.obstacles must be a sequence of file paths, got "
                               f"{self.obstacles!r}")
         object.__setattr__(self, "obstacles", tuple(str(o) for o in self.obstacles))
-        _positive(self.tolerance, "solving.tolerance", optional=False)
-        _count(self.max_iterations, 1, None, "solving.max_iterations")
+        _within(self.tolerance, *TOLERANCE, "solving.tolerance")
+        _count(self.max_iterations, 1, MAX_ITERATIONS, "solving.max_iterations")
         if self.actuation not in ACTUATIONS:
             raise OptionError(f"solving.actuation must be one of {', '.join(ACTUATIONS)}, "
                               f"got {self.actuation!r}")

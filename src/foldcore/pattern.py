@@ -282,7 +282,24 @@ class CreasePattern:
                        "sheet boundary (only one face); assign it 'B'")
         for e in np.flatnonzero((n_sides == 2) & (self.assignments == "B")):
             self._fail(f"edge {e} is assigned 'B' but has faces on both sides")
+        self._validate_fans(flat, n_sides == 2)
         return edge_faces
+
+    def _validate_fans(self, flat: np.ndarray, inner: np.ndarray):
+        """Refuse a vertex where the sheet is pinched: its faces (``flat``: every face
+        corner's vertex) form more than one fan, joined at the vertex alone (a bow-tie).
+
+        The faces about a vertex, linked across its edges with a face on each side
+        (``inner``), are a path (on the boundary: one face more than such edges) or a
+        cycle (inside: as many); one more face than edges again is another fan.
+        """
+        n = self.n_vertices
+        corners = np.bincount(flat, minlength=n)
+        links = np.bincount(self.edges[inner].ravel(), minlength=n)
+        for v in np.flatnonzero(corners - links > 1)[:1]:
+            self._fail(f"vertex {v}: faces meet only at this vertex (a bow-tie); a sheet "
+                       "must hang together along its edges: simulate each piece on its own, "
+                       "or join the faces along an edge")
 
 
 def _reversed_loops(flat, starts, lengths, flip) -> np.ndarray:

@@ -20,6 +20,7 @@ from . import strategies
 from .actuation import BRANCH_FLOOR_DEG, BRANCH_TOLERANCE, DEFAULT_ACTUATION
 from .convergence import ConvergenceTest, Progress
 from .errors import SimulationError
+from .limits import TOLERANCE
 from .model import Model
 from .model.model import BARE_SOLVE_REPEATS
 from .result import Result
@@ -267,11 +268,16 @@ class Simulation:
         Parameters
         ----------
         tolerance : float
-            Relative stopping threshold (the pattern's larger extent, mm, is the scale).
+            Relative stopping threshold (the pattern's larger extent, mm, is the scale),
+            at most 1e-2 (:data:`foldcore.limits.TOLERANCE`: a looser one reads
+            "converged" degrees short of the equilibrium); 0 runs the whole budget.
         max_iterations : int
         callback : callable(sim, moved_mm) -> bool or None, optional
             Called after each iteration; returning False stops the run.
         """
+        if not 0 <= tolerance <= TOLERANCE[1]:
+            raise SimulationError(f"{self.model.pattern.source}: tolerance must be in [0, "
+                                  f"{TOLERANCE[1]:g}] (× the pattern's size), got {tolerance!r}")
         start = time.perf_counter()
         self.progress.runs += 1
         self.timings.setdefault("total", self.timings["setup"])

@@ -11,6 +11,7 @@ import os
 from pathlib import Path
 
 from ..errors import PatternError
+from ..files import check_input
 from ..pattern import CreasePattern
 from .conventions import Reading
 from .fold import MAX_FILE_BYTES, FoldFile, pattern_from_fold_dict, read_fold, read_fold_file
@@ -62,7 +63,8 @@ def read_file(path, *, hinges=None, reading: Reading | None = None) -> FoldFile:
     ------
     PatternError
         Unknown suffix, a hinge file or a scale given where it does not apply,
-        missing hinge file, or any malformed input.
+        a missing file or one that is not a regular file (a named pipe, a
+        device, a folder: refused before it is opened), or any malformed input.
     """
     source = os.fspath(path)
     suffix = Path(source).suffix.lower()
@@ -70,6 +72,9 @@ def read_file(path, *, hinges=None, reading: Reading | None = None) -> FoldFile:
     if suffix in (".fold", ".svg") and hinges is not None:
         raise PatternError(f"{source}: a hinge file only goes with an OBJ/STL mesh, "
                            f"not {'a FOLD file' if suffix == '.fold' else 'an SVG'}")
+    for given in (source, hinges):  # before any is opened: a named pipe blocks a read
+        if given is not None and suffix in (".fold", ".svg", *MESH_SUFFIXES):
+            check_input(given, PatternError)
     if suffix == ".fold":
         return read_fold_file(source, reading)
     if suffix == ".svg":

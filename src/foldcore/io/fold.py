@@ -58,6 +58,7 @@ import numpy as np
 
 from .. import limits
 from ..errors import PatternError
+from ..files import check_input
 from ..hinges import HINGE_MODELS
 from ..pattern import DEFAULT_MAX_ANGLE_DEG, CreasePattern
 from ..planar import Loops, derive_face_loops, freeze, has_repeats, loop_starts, next_in_loop
@@ -206,14 +207,15 @@ def _floats(values: list | None) -> np.ndarray | None:
 
 
 def read_bytes(path, limit: int | None = None) -> bytes:
-    """The bytes of a file, refusing files larger than ``limit`` before reading.
+    """The bytes of a regular file (:func:`foldcore.files.check_input`), refusing files
+    larger than ``limit`` before reading.
 
     ``limit`` defaults to :data:`MAX_FILE_BYTES` (read at call time).
     """
     source = os.fspath(path)
     limit = MAX_FILE_BYTES if limit is None else limit
+    size = check_input(source, PatternError).st_size  # a named pipe would block the read
     try:
-        size = os.stat(source).st_size
         if size > limit:
             fail(source, f"file is {size} bytes, larger than the {limit}-byte limit")
         with open(source, "rb") as fh:

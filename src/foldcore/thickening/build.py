@@ -5,13 +5,14 @@ from typing import NamedTuple
 
 import numpy as np
 
+from ..limits import check_mesh_size
 from ..mesh import ThickMesh
 from ..pattern import CreasePattern
 from .cells import elastic_cells
 from .geometry import PointTable
 from .groups import crease_panels, hinge_group, panel_group, stretch_group
-from .inputs import (check_stiffness, check_thickness, plate_counts, resolve_stretch,
-                     split_elastic, strip_segments)
+from .inputs import (check_stiffness, check_thickness, mesh_vertices, plate_counts,
+                     resolve_stretch, split_elastic, strip_segments)
 from .panels import panel_corners, panel_loops
 from .strips import build_strips
 from .widths import resolve_hinges, resolve_subdivisions, resolve_widths
@@ -35,7 +36,8 @@ def thicken(pattern: CreasePattern, thickness: float, hinge_width=None,
         Hinge width W per edge, mm; overrides the pattern's widths. NaN entries
         (and patterns without widths) use Eq. 7, W = (r + H/2)·θmax.
     subdivisions : int, (E,) ints or "auto"
-        Sub-strips per hinge; "auto" uses :func:`auto_subdivisions`.
+        Sub-strips per hinge, each in 1..64 (:data:`foldcore.limits.SUBDIVISIONS`);
+        "auto" uses :func:`auto_subdivisions`.
     bend_radius : float
         Inner bend radius r for Eq. 7 widths, mm.
     hinge : {"axis", "arc", "eq8", "slack"} or (E,) of them (None entries: default), optional
@@ -61,6 +63,13 @@ def thicken(pattern: CreasePattern, thickness: float, hinge_width=None,
     Returns
     -------
     ThickMesh
+
+    Raises
+    ------
+    MeshError
+        Among others, when the mesh would have more vertices than
+        :data:`foldcore.limits.MAX_MESH_VERTICES`, or its elastic cells more than
+        :data:`foldcore.limits.MAX_ELASTIC_VERTICES` (estimated before it is built).
     """
     sheet = _resolve(pattern, thickness, hinge_width, subdivisions, bend_radius, hinge,
                      stiffness, stretch)
@@ -69,6 +78,8 @@ def thicken(pattern: CreasePattern, thickness: float, hinge_width=None,
     bars, plates, facets = split_elastic(pattern, elastic)
     plates = plate_counts(pattern, plates, corners, cell_size)
     segments = strip_segments(pattern, plates, sheet.stretch, bars)
+    check_mesh_size(*mesh_vertices(pattern, sheet.ks, segments, corners,
+                                   (bars, plates, facets), cell_size), pattern.source)
     strip_points, inserts = build_strips(pattern, sheet.widths, sheet.ks, segments, corners,
                                          corner_ids, table)
     loops = panel_loops(corner_ids, inserts)

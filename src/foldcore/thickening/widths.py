@@ -5,6 +5,7 @@ import numpy as np
 
 from ..errors import MeshError
 from ..hinges import DEFAULT_HINGE, HINGE_MODELS
+from ..limits import SUBDIVISIONS
 
 __all__ = ["MAX_SUBDIVISIONS", "auto_subdivisions", "minimum_hinge_width", "resolve_hinges",
            "resolve_subdivisions", "resolve_widths"]
@@ -90,7 +91,8 @@ def resolve_subdivisions(pattern, widths, thickness, subdivisions, hinges) -> np
                                       hinges[crease])
         return k
     k = np.broadcast_to(np.asarray(subdivisions), (pattern.n_edges,))
-    if not np.issubdtype(k.dtype, np.integer) or (k[crease] < 1).any():
-        raise MeshError(f"{pattern.source}: subdivisions must be a positive integer or "
+    lo, hi = SUBDIVISIONS
+    if not np.issubdtype(k.dtype, np.integer) or ((k[crease] < lo) | (k[crease] > hi)).any():
+        raise MeshError(f"{pattern.source}: subdivisions must be integers in {lo}..{hi} or "
                         f"'auto', got {subdivisions!r}")
     return np.where(crease, k, 0).astype(np.int64)
