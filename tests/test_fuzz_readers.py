@@ -766,6 +766,14 @@ def test_fold_regressions(name):
         assert needle in str(info.value), str(info.value)
 
 
+def test_fold_dict_with_an_array_among_its_frame_classes():
+    """A caller's dict whose ``frame_classes`` holds a numpy array: not a class name
+    (``"foldedForm" in classes`` compared it element-wise and raised ValueError)."""
+    d = copy.deepcopy(BASE_FOLDS[0])
+    d["frame_classes"] = [np.array([0.0, 1.0])]
+    assert_valid(pattern_from_fold_dict(d, "dict"))
+
+
 def test_fold_dict_python_sequences():
     """A Python caller's tuples and an empty NumPy faces array read as the equivalent
     JSON file does."""

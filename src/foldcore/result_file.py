@@ -26,8 +26,8 @@ import numpy as np
 from . import limits
 from .errors import PatternError
 from .io.fold import edges_poisson, faces_cells, fold_file_from_dict, read_bytes
-from .io.fold_json import (ARRAY, UNIT_MM, check_length, fail, index, number, number_table,
-                           parse_json, short)
+from .io.fold_json import (ARRAY, UNIT_MM, check_length, fail, has_class, index, number,
+                           number_table, parse_json, short)
 
 #: Largest |coordinate| of a folded frame's vertex, mm (after ``frame_unit``): the
 #: largest sheet accepted (1e7 mm across, ``limits.LENGTH_MM``) moved 1e8 × its
@@ -251,7 +251,7 @@ def _is_folded(frame: dict, i: int, source: str) -> bool:
     if not isinstance(classes, list):
         fail(source, f"file_frames[{i}].frame_classes must be a list of strings, "
                      f"got {short(classes)}")
-    return "foldedForm" in classes
+    return has_class(classes, "foldedForm")
 
 
 def _frame_title(title, i: int, source: str) -> str:

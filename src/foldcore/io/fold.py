@@ -65,8 +65,8 @@ from ..planar import Loops, derive_face_loops, freeze, has_repeats, loop_starts,
 from .conventions import Reading, assigned_angles, into_plane, note, trust_signs
 from .fold_json import (ARRAY, CELLS_KEY, EDGE_STIFFNESS_KEY,  # noqa: F401  (part of this API)
                         FACE_STIFFNESS_KEY, HINGE_KEY, MAX_ANGLE_KEY, POISSON_KEY, TARGET_KEY,
-                        THICKNESS_KEY, UNIT_MM, WIDTH_KEY, check_length, fail, index, int_table,
-                        number, number_table, parse_json, required_list, short)
+                        THICKNESS_KEY, UNIT_MM, WIDTH_KEY, check_length, fail, has_class, index,
+                        int_table, number, number_table, parse_json, required_list, short)
 
 #: Largest input file read, bytes (256 MiB).
 MAX_FILE_BYTES = 256 * 1024 * 1024
@@ -242,7 +242,7 @@ def _crease_pattern_coords(d: dict, source: str) -> list:
     """The rows of the crease pattern's coordinates: ``vertices_coords``, or a folded
     form's ``vertices_flatUnfoldCoords`` (said)."""
     classes = d.get("frame_classes")
-    folded = isinstance(classes, ARRAY) and "foldedForm" in classes
+    folded = has_class(classes, "foldedForm")
     if d.get("vertices_flatUnfoldCoords") is not None and folded:
         rows = required_list(d, "vertices_flatUnfoldCoords", source)
         note(source, "a folded form: its crease pattern read from vertices_flatUnfoldCoords")

@@ -140,6 +140,15 @@ def int_table(rows, width: int) -> np.ndarray | None:
         return None
 
 
+def has_class(classes, name: str) -> bool:
+    """Whether a FOLD ``frame_classes`` value (a list of strings, or anything a file
+    or a caller's dict holds) names ``name``; compared string by string, so an
+    array or other object in the list is no match (``in`` would compare it
+    element-wise)."""
+    return isinstance(classes, ARRAY) and any(isinstance(c, str) and c == name
+                                               for c in classes)
+
+
 def fail(source: str, message: str):
     """Raise PatternError ``source: message``."""
     raise PatternError(f"{source}: {message}")
