@@ -129,16 +129,41 @@ def results(crease, tmp_path_factory):
     return [json.loads(out.read_text())]
 
 
+@pytest.mark.parametrize("command", ["view", "export", "render"])
 @FUZZ
-@given(data=st.data(), command=st.sampled_from(["view", "export"]))
+@given(data=st.data())
 def test_fuzz_result_commands(results, tmp_path_factory, data, command):
-    """``view`` and ``export`` on corrupted result files."""
+    """``view``, ``export`` and ``render`` on corrupted result files (renders small)."""
     folder = tmp_path_factory.mktemp(command)
     d = data.draw(corrupted_results(results))
     path = folder / "r.fold"
     path.write_bytes(_json_bytes(d) or b"{}")
-    output = data.draw(st.sampled_from(["out.html" if command == "view" else "out.stl",
-                                        "", "none/out.x", "x" * 300 + ".html"]))
-    flag = "-o" if command == "view" else data.draw(st.sampled_from(["--stl", "--svg"]))
+    good = {"view": "out.html", "export": "out.stl", "render": "out.png"}[command]
+    output = data.draw(st.sampled_from([good, "", "none/out.x", "x" * 300 + ".html"]))
+    flag = "--stl" if command == "export" else "-o"
+    if command == "export":
+        flag = data.draw(st.sampled_from(["--stl", "--svg"]))
     argv = [command, str(path)] + ([flag, str(folder / output)] if output else [])
+    if command == "render":
+        argv += ["--size", data.draw(st.sampled_from(["64x48", "0x0", "64", "nan", "1e9x1"]))]
     check(argv, folder, ["r.fold", output.split("/")[0]])
+
+
+@FUZZ
+@given(name=st.sampled_from(["d4v", "box", "chain", "nope", "", "../d4v", "D4V"]),
+       options=st.lists(st.sampled_from([["--solver", "x"], ["--contact", "maybe"],
+                                         ["--out", ""], ["--bogus"], ["--solver"],
+                                         ["--out", "x" * 300]]), min_size=1, max_size=3))
+def test_fuzz_scene_arguments(tmp_path_factory, name, options):
+    """``scene`` with a name or an option it cannot take (a scene that runs is a long
+    fold; tests/test_scenes.py runs them): always refused in one line, nothing
+    written."""
+    folder = tmp_path_factory.mktemp("scene")
+    argv = ["scene", name, "--quick", *[part for option in options for part in option]]
+    if name in ("d4v", "box", "chain") and all(o[0] == "--out" and o[1] for o in options):
+        argv += ["--solver", "x"]  # keep it a refusal
+    code, err = run(argv + (["--out", str(folder)] if "--out" not in argv else []))
+    assert code == 2 and "Traceback" not in err, err
+    assert len([line for line in err.splitlines() if line.strip()]) == 1, err
+    assert os.listdir(folder) == []
+    event("refused")
