@@ -85,6 +85,14 @@ class Strategy:
         measure of its own, the equilibrium probe of the paper's model judges."""
         return None
 
+    def refused(self) -> bool:
+        """The convergence test refused a state this strategy called settled: the
+        model's equilibrium is farther than the run's limit
+        (`docs/architecture.md#the-equilibrium-certificate`). Returns whether the
+        strategy's steps go on toward it (default True: the test checks again when
+        it next settles); False where they cannot (the run ends ``stalled``)."""
+        return True
+
     @property
     def stalled(self) -> bool:
         """Whether the steps are at the strategy's resolution: they no longer change
