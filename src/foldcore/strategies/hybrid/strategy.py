@@ -75,6 +75,7 @@ class Hybrid(Strategy):
         self._start = None  # the rigid phase of a mesh in rings while it runs (RigidStart)
         # slack hinges: the rigid phase holds their strips at their shortest, newton frees them
         self._slack = bool(len(slack_creases(model.mesh)))
+        self._rigid_settled = False  # the last report was the rigid phase's settled state
 
     def _finishing(self) -> Strategy:
         """The strategy after (or instead of) the rigid phase: ``newton`` on a mesh whose
@@ -156,6 +157,7 @@ class Hybrid(Strategy):
         return self.rigid.step()
 
     def report(self, moved: float, limit: float) -> Report:
+        self._rigid_settled = False
         if self._start is not None:
             return Report(moved, settled=self._settled_start(moved, limit),
                           stalled=self.stalled)
@@ -197,8 +199,25 @@ class Hybrid(Strategy):
                 self._finish_with_newton()
                 log.info("hybrid: rigid phase ends unsettled after %d steps; %s finishes",
                          self._rigid_steps, self.finish.name)
+            self._rigid_settled = done
             self._leave_rigid_phase()
         return done
+
+    def refused(self) -> bool:
+        """The convergence test refused a settled state. Where the rigid phase settled
+        it, the rigid-body model's equilibrium is not the mesh's (a binding fold its
+        panels resolve by bending, a passive crease its bounds hold): ``newton`` (or
+        the default finish where it refuses the mesh) goes on from it. Else the
+        finishing strategy says."""
+        if not self._rigid_settled:
+            return self.finish.refused()
+        self._rigid_settled = False
+        self._engine.refused()  # no run end to extrapolate from, no twin to continue
+        self._finish_with_newton()
+        self.finish.restart()
+        log.info("hybrid: the rigid phase's equilibrium is not the mesh's; %s finishes",
+                 self.finish.name)
+        return True
 
     def _finish_with_newton(self) -> None:
         """After a rigid phase that handed over unsettled, ``newton`` finishes (where it

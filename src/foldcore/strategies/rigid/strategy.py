@@ -218,6 +218,15 @@ class Rigid(Strategy):
         self._drop_twin()  # the mesh's own steps finish
         return False
 
+    def refused(self) -> bool:
+        """The convergence test refused the rigid-body model's equilibrium (the mesh's,
+        every element free, is elsewhere: a binding fold its panels resolve by
+        bending, a passive crease its bounds hold): these steps cannot leave it, so
+        the run ends ``stalled``; the state is no run end to extrapolate from."""
+        self.engine.forget_ends()
+        self._drop_twin()
+        return False
+
     def predict(self, ratio: float) -> bool:
         """Extrapolate the last two run ends: on the kept twin when the next run goes on
         on it (the mesh keeps its state until the twin hands over), else on the
