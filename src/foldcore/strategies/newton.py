@@ -112,6 +112,7 @@ class Newton(Strategy):
                                   f"bending hinges (mesh has {sorted(other)}); use 'lbfgs'")
         self.lam = self.options.lambda_start
         self.accepted = False
+        self.stuck = False  # whether the last step found no damping that lowers E
         self.undamped = False  # whether the last accepted step's damping was ≤ lambda_settled
         self.moves = []  # the run's accepted step lengths, mm
         self.level = 0  # accepted steps in a row whose E changed within rounding (stalled)
@@ -128,7 +129,7 @@ class Newton(Strategy):
 
     def restart(self) -> None:
         self.lam, self.moves, self.energy_max, self.level = self.options.lambda_start, [], 0.0, 0
-        self._at = None
+        self._at, self.stuck = None, False
 
     def begin_run(self) -> None:
         self.moves, self.energy_max, self.level = [], 0.0, 0
@@ -160,11 +161,12 @@ class Newton(Strategy):
                     trial_energy += trial_touch.energy
             if trial_energy <= energy + noise:
                 self.accepted, self.undamped = True, self.lam <= o.lambda_settled
+                self.stuck = False
                 self.lam = max(self.lam / o.lambda_down, o.lambda_min)
                 break
             self.lam *= o.lambda_up
             if self.lam > o.lambda_max:  # no decrease at any damping: not a verdict
-                self.accepted, self.lam = False, o.lambda_start
+                self.accepted, self.lam, self.stuck = False, o.lambda_start, True
                 model.local_step(x)
                 return energy, 0.0
         moved = float(np.abs(trial - x).max())
@@ -213,7 +215,12 @@ class Newton(Strategy):
         were no shorter than half the first third's: the steps wander at the
         resolution E can judge, where without this a binding fold at a tight
         tolerance ran its whole budget; steps that still shrink are converging
-        and go on (`docs/architecture.md#newton`)."""
+        and go on (`docs/architecture.md#newton`). Also a step that no damping made
+        lower E (with K unchanged the next one would be the same, each up to ~25
+        factorisations): the convergence test then certifies the state or calls
+        it stalled."""
+        if self.stuck and not self.model.pins.fading():
+            return True
         steps = self.options.stall_steps
         if self.level < steps:
             return False
