@@ -5,9 +5,10 @@ Each run starts with a rigid phase (:mod:`..rigid`) from the current positions
 are built once). A rigid step that settles ends the run there: the rigid-body
 model's equilibrium (panels exactly rigid, each passive crease one bounded
 bend), where the run's equilibrium certificate finds it the mesh's too; where
-it does not (:meth:`Hybrid.refused`) ``newton`` goes on from it. Otherwise the phase ends when an accepted step moves ≤ ``rigid_tol`` ×
-size or after ``rigid_max_steps`` steps, and :mod:`..newton` continues from
-where it stopped on the paper's own energy (:mod:`..lbfgs` on meshes
+it does not (:meth:`Hybrid.refused`) ``newton`` goes on from it. Otherwise the
+phase ends when an accepted step moves ≤ ``rigid_tol`` × size or after
+``rigid_max_steps`` steps, and :mod:`..newton` continues from where it stopped
+on the paper's own energy (:mod:`..lbfgs` on meshes
 ``newton`` refuses, e.g. stretch hinges). A mesh the rigid phase cannot take
 runs one strategy alone: L-BFGS, or ``newton`` where every elastic face is
 cut into rings, which from the rest state starts on the mesh's rigid-panel
