@@ -15,9 +15,12 @@ model's own Gauss–Newton linearisation (:mod:`foldcore.model.linearisation`)
    without the sheet's rigid motion, from λ = ``DAMPING[0]`` (nearly undamped).
 3. Its predicted move |δ|∞ within the run's limit (tolerance × size):
    certified. Else E at x + δ decides: lower than E by more than its rounding,
-   or within it (E cannot tell the two states apart), the equilibrium is not
-   within the limit — refused; higher (the linear model overshot), λ grows by
-   ``DAMPING_UP`` and the step is solved again, up to ``DAMPING[1]``.
+   the equilibrium is farther than the limit — refused; higher (the linear
+   model overshot), λ grows by ``DAMPING_UP`` and the step is solved again, up
+   to ``DAMPING[1]``. Within E's rounding: the first, nearly undamped step
+   lands on a state E cannot tell from this one (the tolerance is below what
+   the state resolves: refused); a damped one after an overshoot is no
+   evidence of a lower state (damped further).
 
 Scale-free: the move is compared with tolerance × size, energy changes with
 E's rounding at the state, λ is relative to K's diagonal; the same state in mm
@@ -107,15 +110,17 @@ class Certificate:
                 return move, True
             change = (model.local_step(x + delta)[0] - energy) / noise
             self.trials.append((damping, share, change))
-            if not change > 1.0:  # a lower state, or one E cannot tell from this one
-                return move, False
+            if change < -1.0 or (abs(change) <= 1.0 and len(self.trials) == 1):
+                return move, False  # a lower state, or the Newton step E cannot judge
             damping *= DAMPING_UP  # the linear model overshot: a shorter step
         return move, False
 
     def energy_floor(self) -> float:
         """mm⁵: the energy of residuals at rounding level (every vertex off by
-        ``ROUNDING`` × the size), below which changes are noise even where E is 0."""
+        ``ROUNDING`` × its coordinates' magnitude: the size, or the thickness of a
+        block thicker than its pattern is wide), below which changes are noise even
+        where E is 0."""
         model = self.model
-        return (model.system.reference_weight * model.mesh.n_vertices
-                * (ROUNDING * model.length_scale) ** 2)
+        reach = max(model.length_scale, float(np.abs(model.x).max(initial=0.0)))
+        return model.system.reference_weight * model.mesh.n_vertices * (ROUNDING * reach) ** 2
 
