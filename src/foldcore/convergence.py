@@ -16,7 +16,9 @@ element of the mesh (:class:`foldcore.certificate.Certificate`), and so does
 the state a run's budget ends at. A state the certificate refuses is not
 converged: the probe's strategies go on (their probe waits), a strategy with
 its own measure is asked whether its steps go on (``Strategy.refused``:
-``hybrid`` hands over to its finishing strategy) or the run ends ``stalled``
+``hybrid`` hands over to its finishing strategy) or the run ends ``stalled``.
+A strategy that is a model of its own, asked for by name (``rigid``: panels
+exactly rigid; ``Strategy.own_model``), keeps its own test's verdict
 (`docs/architecture.md#the-equilibrium-certificate`).
 """
 from __future__ import annotations
@@ -140,11 +142,12 @@ class ConvergenceTest:
 
     def applies(self) -> bool:
         """Whether the certificate judges this state: not at a branch stage's end (not
-        the run's), nor where contact acts (a barrier term within reach, or the last
+        the run's), nor of a strategy that is a model of its own (``own_model``:
+        ``rigid``), nor where contact acts (a barrier term within reach, or the last
         step cut short): the strategies keep panels apart by rules of their own
         (`docs/architecture.md#the-equilibrium-certificate`)."""
         contact = self._model.contact
-        if self._progress.stage == "branch":
+        if self._progress.stage == "branch" or getattr(self.strategy, "own_model", False):
             return False
         return contact is None or not (contact.blocking or
                                        contact.state(self._model.x).active)

@@ -47,6 +47,10 @@ class Strategy:
     #: rate then ends at once, ``stalled``.
     plain_map: bool = False
     supports_contact: bool = False  # its steps keep panels apart (``model.contact``)
+    #: Whether the strategy is a model of its own, asked for by name (``rigid``: panels
+    #: exactly rigid), whose verdict is its own test's; the equilibrium certificate
+    #: of the mesh judges every other (`docs/architecture.md#the-equilibrium-certificate`).
+    own_model: bool = False
     Options = NoOptions
 
     def __init_subclass__(cls, **kwargs):
