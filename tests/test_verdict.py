@@ -589,3 +589,37 @@ def test_a_tolerance_below_the_resolution_is_stalled_in_every_unit(solver):
                                                                max_iterations=300)
         assert result.reason == "stalled"
         assert 1e-12 < result.residual < 1e-10
+
+
+def test_a_budget_that_ends_at_a_certified_state_is_converged():
+    """L-BFGS folds this hinge in 47 iterations, the last ten the probe's hold; its
+    state is certified from iteration 36 on (measured): a budget of 40 ends there
+    ``converged``, one of 30 ends with the state 4e-4 × the size away, ``budget``."""
+    pattern, mesh = hinge_to_90(1e-1)
+    early = Simulation(mesh, pattern, solver="lbfgs").run(tolerance=1e-8, max_iterations=40)
+    assert early.reason == "converged" and early.iterations == 40 and early.residual <= 1e-8
+    short = Simulation(mesh, pattern, solver="lbfgs").run(tolerance=1e-8, max_iterations=30)
+    assert short.reason == "budget" and short.residual > 1e-8
+
+
+def test_the_certificate_damps_no_further_than_its_last_step():
+    """Where every trial raises E (stubbed here; a passive strip's Eq. 9 target under
+    load does it), damping shrinks the step until it is within the limit; the last
+    damping (1e4 × K's diagonal) bounds how large a gradient may pass that way: the
+    flat sheet, 60° from its target, is refused, its step at that damping still
+    beyond the limit."""
+    from foldcore.certificate import Certificate
+
+    pattern, mesh = scaled("hinge", 1.0)
+    sim = Simulation(mesh, pattern, solver="newton")
+    model, real = sim.model, sim.model.local_step
+
+    def rising(x):
+        energy, rhs = real(x)
+        return (energy if x is model.x else energy + 1e6 * (1.0 + energy)), rhs
+
+    model.local_step = rising
+    certificate = Certificate(model)
+    assert not certificate.check(1e-8 * sim.length_scale)
+    assert all(change > 1.0 for _, _, change in certificate.trials)
+    assert certificate.trials[-1][0] == pytest.approx(1e4) and certificate.trials[-1][1] > 1.0
