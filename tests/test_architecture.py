@@ -167,7 +167,7 @@ LAYERS = [
      "foldcore.surface"),
     ("foldcore.simulation", "foldcore.result"),
     ("foldcore.strategies",),
-    ("foldcore.convergence", "foldcore.probe"),
+    ("foldcore.convergence", "foldcore.probe", "foldcore.certificate"),
     ("foldcore.model",),
     ("foldcore.system", "foldcore.linsolve", "foldcore.threads"),
     ("foldcore.thickening", "foldcore.io", "foldcore.pattern", "foldcore.mesh",

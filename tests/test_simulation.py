@@ -310,20 +310,33 @@ def test_k_is_factorised_at_its_first_use_and_then_matches_the_current_weights()
                                atol=1e-12 * np.abs(fresh.solve(rhs)).max())
 
 
+def settle(sim, max_iterations=3_000):
+    """A run that ends at a state its strategies cannot leave: converged, or stalled
+    where the equilibrium certificate refuses it."""
+    result = sim.run(tolerance=1e-9, max_iterations=max_iterations)
+    assert result.reason in ("converged", "stalled"), result.reason
+    return result
+
+
 def test_the_result_says_how_far_each_position_target_is_and_why():
     """The left panel held, a right corner lifted where the hinge can take it: met
     (stopped_by None); pulled away in the sheet's plane, which would stretch the
-    rigid panels and the hinge: a compromise with them ("pull")."""
+    rigid panels and the hinge: a compromise with them ("pull"). The rigid phase's
+    equilibrium is not the mesh's (its elastic panels give 0.014 mm to the pull), and
+    ``newton``, which goes on from it, stops where no damping lowers E while the
+    passive hinge's Eq. 9 target still leaves a lower state: the run says
+    ``stalled`` rather than ``converged`` (docs/architecture.md#the-equilibrium-certificate);
+    what the result says of the targets holds either way."""
     pattern, mesh = hinge(assignment="U")
     sim = Simulation(mesh, pattern)
     x = sim.positions
     sim.add_position_target(np.flatnonzero(x[:, 0] < -0.6 * PANEL), name="held")
     corner = sim.nearest_vertex([PANEL, 2.0, H / 2])
     sim.add_position_target([corner], x[corner] + [0.0, 0.0, 0.5], name="lift")
-    met = {t["name"]: t for t in converge(sim).position_targets}
+    met = {t["name"]: t for t in settle(sim).position_targets}
     assert met["lift"]["vertices"] == 1 and met["lift"]["stopped_by"] is None
     assert met["held"]["stopped_by"] is None
     sim.move_position_target("lift", x[corner] + [2.0, 0.0, 0.0])
-    pulled = {t["name"]: t for t in converge(sim).position_targets}
+    pulled = {t["name"]: t for t in settle(sim).position_targets}
     assert pulled["lift"]["stopped_by"] == "pull" and 0.1 < pulled["lift"]["miss_mm"] < 2.0
     assert Simulation(mesh, pattern).run(max_iterations=2).position_targets is None

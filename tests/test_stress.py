@@ -68,11 +68,13 @@ def test_same_scene_in_three_units_follows_the_same_path(solver):
 
 def test_anderson_converges_to_the_same_state_in_three_units():
     """Anderson's extrapolation amplifies rounding along the path (2.7e-7 relative at
-    iteration 30, measured), so only its converged state is compared."""
+    iteration 30, measured), so only its converged state is compared. At 1e-11: the
+    equilibrium certificate resolves this hinge to ~2e-12 × its size (at 1e-13 the
+    run ends ``stalled`` in every unit)."""
     angles = {}
     for unit, factor in UNITS.items():
         pattern, mesh = scaled_hinge(factor, angle=60.0)
-        result = Simulation(mesh, pattern, solver="anderson").run(tolerance=1e-13,
+        result = Simulation(mesh, pattern, solver="anderson").run(tolerance=1e-11,
                                                                   max_iterations=2000)
         assert result.converged
         angles[unit] = np.r_[result.fold_angles_deg[:1], result.strip_angles_deg]

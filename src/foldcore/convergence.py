@@ -9,6 +9,17 @@ rigid-body strategy's stopping rule, ``newton``'s) says whether its state
 is settled; a strategy without one (the local/global maps) is judged by the
 equilibrium probe of the paper's model (:class:`foldcore.probe.EquilibriumProbe`).
 A small step alone is never a verdict: `docs/architecture.md#a-small-step-is-not-a-verdict`.
+
+Neither is a strategy's own test: before a run ends ``converged`` its state
+must pass the equilibrium certificate of the model the user asked for, every
+element of the mesh (:class:`foldcore.certificate.Certificate`), and so does
+the state a run's budget ends at. A state the certificate refuses is not
+converged: the probe's strategies go on (their probe waits), a strategy with
+its own measure is asked whether its steps go on (``Strategy.refused``:
+``hybrid`` hands over to its finishing strategy) or the run ends ``stalled``.
+A strategy that is a model of its own, asked for by name (``rigid``: panels
+exactly rigid; ``Strategy.own_model``), keeps its own test's verdict
+(`docs/architecture.md#the-equilibrium-certificate`).
 """
 from __future__ import annotations
 
@@ -78,12 +89,28 @@ class ConvergenceTest:
     ----------
     model : foldcore.model.Model
     progress : Progress
+
+    Attributes
+    ----------
+    probe : foldcore.probe.EquilibriumProbe
+    certificate : foldcore.certificate.Certificate
+    strategy : foldcore.strategies.Strategy or None
+        The strategy whose settled states the test certifies (:meth:`attach`).
     """
 
     def __init__(self, model, progress: Progress):
+        from .certificate import Certificate
         from .probe import EquilibriumProbe
 
         self.probe = EquilibriumProbe(model, progress)
+        self.certificate = Certificate(model)
+        self.strategy = None
+        self._model, self._progress = model, progress
+
+    def attach(self, strategy) -> None:
+        """The strategy the run's reports come from: asked whether it goes on where
+        the certificate refuses a state it called settled."""
+        self.strategy = strategy
 
     @property
     def residual(self) -> float:
@@ -97,20 +124,49 @@ class ConvergenceTest:
         if report.residual is not None:
             self.probe.residual = report.residual
         settled = report.settled
-        if settled is None:
+        probed = settled is None
+        if probed:
             settled = self.probe.settled(report.moved, limit)
         if settled:
-            return "converged"
-        if report.stalled:
-            return "stalled"
-        if report.plain_map and self.probe.hopeless(limit, steps_left):
-            return "stalled"
+            if not self.applies() or self.certified(limit):
+                return "converged"
+            if probed:  # the probe's strategies go on; its next check waits
+                self.probe.refuse(self.certificate.residual)
+            elif not (self.strategy is not None and self.strategy.refused()):
+                return "stalled"  # the strategy's steps cannot leave its own equilibrium
+        stalled = report.stalled or (report.plain_map and self.probe.hopeless(limit, steps_left))
+        if stalled:  # steps at their resolution may have reached the equilibrium
+            return "converged" if not settled and self.applies() and self.certified(limit) \
+                else "stalled"
         return None
 
-    def at_budget(self) -> str:
-        """The reason of a run whose budget ran out: ``"stalled"`` where its last check
-        found the equilibrium farther than the limit, else ``"budget"``."""
-        return "stalled" if self.probe.failed else "budget"
+    def applies(self) -> bool:
+        """Whether the certificate judges this state: not at a branch stage's end (not
+        the run's), nor of a strategy that is a model of its own (``own_model``:
+        ``rigid``), nor where contact acts (a barrier term within reach, or the last
+        step cut short): the strategies keep panels apart by rules of their own
+        (`docs/architecture.md#the-equilibrium-certificate`)."""
+        contact = self._model.contact
+        if self._progress.stage == "branch" or getattr(self.strategy, "own_model", False):
+            return False
+        return contact is None or not (contact.blocking or
+                                       contact.state(self._model.x).active)
+
+    def certified(self, limit: float) -> bool:
+        """Whether the model's state passes the equilibrium certificate at ``limit`` mm;
+        its residual becomes the test's."""
+        passed = self.certificate.check(limit)
+        self.probe.residual = self.certificate.residual
+        return passed
+
+    def at_budget(self, limit: float | None = None) -> str:
+        """The reason of a run whose budget ran out: ``"converged"`` where its state
+        passes the certificate at ``limit`` mm, else ``"stalled"`` where its last
+        check found the equilibrium farther than the limit, else ``"budget"``."""
+        failed = self.probe.failed
+        if limit is not None and self.applies() and self.certified(limit):
+            return "converged"
+        return "stalled" if failed else "budget"
 
     def begin_run(self) -> None:
         """A run starts (its stages each call :meth:`new_stage`)."""

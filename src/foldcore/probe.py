@@ -117,6 +117,15 @@ class EquilibriumProbe:
             self._probe_later()
         return not self.failed
 
+    def refuse(self, residual: float) -> None:
+        """The equilibrium certificate refused a state this probe passed: the check
+        failed, with the certificate's estimate (``residual``, / size) if larger,
+        and the next probe waits (:meth:`_probe_later`)."""
+        if not self.residual >= residual:  # (NaN before any probe of the stage)
+            self.residual = residual
+        self.failed, self._anchor = True, None
+        self._probe_later()
+
     def _probe_later(self) -> None:
         """After a failed check: the next probe waits as many iterations as the stage
         has taken, at least ``PROBE_STEPS``."""

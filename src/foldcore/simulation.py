@@ -105,6 +105,7 @@ class Simulation:
         self.model.contact = contact_model(self.model, strategy, contact, obstacles)
         self._bare_solve = None  # (K version, seconds) of the last bare-solve timing
         self.strategy = strategy(self.model, self.progress, options)  # moves model.x
+        self.convergence.attach(self.strategy)
         self.model.subscribe(self._targets_changed)
 
     # ------------------------------------------------------------ the model
@@ -336,7 +337,7 @@ class Simulation:
             reason = self.convergence.check(report, limit, budget - used)
             if reason is not None:
                 return reason
-        return self.convergence.at_budget()
+        return self.convergence.at_budget(limit)
 
     def _starts_flat(self) -> bool:
         """Whether this run needs the branch stage: a floor is set, some passive crease

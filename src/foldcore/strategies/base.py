@@ -47,6 +47,10 @@ class Strategy:
     #: rate then ends at once, ``stalled``.
     plain_map: bool = False
     supports_contact: bool = False  # its steps keep panels apart (``model.contact``)
+    #: Whether the strategy is a model of its own, asked for by name (``rigid``: panels
+    #: exactly rigid), whose verdict is its own test's; the equilibrium certificate
+    #: of the mesh judges every other (`docs/architecture.md#the-equilibrium-certificate`).
+    own_model: bool = False
     Options = NoOptions
 
     def __init_subclass__(cls, **kwargs):
@@ -84,6 +88,14 @@ class Strategy:
         the state is its model's equilibrium within ``limit`` mm. Default None: no
         measure of its own, the equilibrium probe of the paper's model judges."""
         return None
+
+    def refused(self) -> bool:
+        """The convergence test refused a state this strategy called settled: the
+        model's equilibrium is farther than the run's limit
+        (`docs/architecture.md#the-equilibrium-certificate`). Returns whether the
+        strategy's steps go on toward it (default True: the test checks again when
+        it next settles); False where they cannot (the run ends ``stalled``)."""
+        return True
 
     @property
     def stalled(self) -> bool:

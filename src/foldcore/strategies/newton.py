@@ -41,7 +41,7 @@ With contact (``model.contact``) the barrier joins E, its gradient and
 PSD-projected blocks join the step, and every trial is moved back until its
 straight-line motion is collision-free (:mod:`.vertex_contact`).
 
-Cost per step: one assembly of H into a fixed pattern (:class:`HessianPattern`)
+Cost per step: one assembly of H into a fixed pattern (:class:`~foldcore.model.linearisation.HessianPattern`)
 and one sparse Cholesky per trial (CHOLMOD refactors in place, else SciPy),
 plus 1 + ``corrections`` local steps and K solves per trial (the accepted
 trial's projections serve the next step). Units: mm.
@@ -51,13 +51,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.sparse as sp
-
-from elements import bending_hinge
-from elements.bending_hinge import MODEL, SLACK
 
 from ..errors import SimulationError
-from ..linsolve import Factor
+from ..model.linearisation import Linearisation, without_rigid_motion
 from .base import Strategy
 from .vertex_contact import VertexContact
 
@@ -116,6 +112,7 @@ class Newton(Strategy):
                                   f"bending hinges (mesh has {sorted(other)}); use 'lbfgs'")
         self.lam = self.options.lambda_start
         self.accepted = False
+        self.stuck = False  # whether the last step found no damping that lowers E
         self.undamped = False  # whether the last accepted step's damping was ≤ lambda_settled
         self.moves = []  # the run's accepted step lengths, mm
         self.level = 0  # accepted steps in a row whose E changed within rounding (stalled)
@@ -128,12 +125,11 @@ class Newton(Strategy):
 
         self._at = None  # the accepted trial's projections, reused by the next step
         self.contact = VertexContact(model) if model.contact is not None else None
-        self.hessian_pattern = None  # HessianPattern of the current K (and contact blocks)
-        self._factor = None  # Factor of H + λ D, refactored in place while the pattern holds
+        self.linear = Linearisation(model)  # H in its fixed pattern, and its factor
 
     def restart(self) -> None:
         self.lam, self.moves, self.energy_max, self.level = self.options.lambda_start, [], 0.0, 0
-        self._at = None
+        self._at, self.stuck = None, False
 
     def begin_run(self) -> None:
         self.moves, self.energy_max, self.level = [], 0.0, 0
@@ -152,7 +148,7 @@ class Newton(Strategy):
             delta = self._solve(hessian, -gradient).reshape(-1, 3)
             if not (model.position_targets or (self.contact and
                                                self.contact.holds_rigid_motion)):
-                delta = _without_rigid_motion(delta, x)
+                delta = without_rigid_motion(delta, x)
             trial = self._corrected(x + delta)
             if self.contact is not None:
                 trial = self.contact.collision_free(x, trial)
@@ -165,11 +161,12 @@ class Newton(Strategy):
                     trial_energy += trial_touch.energy
             if trial_energy <= energy + noise:
                 self.accepted, self.undamped = True, self.lam <= o.lambda_settled
+                self.stuck = False
                 self.lam = max(self.lam / o.lambda_down, o.lambda_min)
                 break
             self.lam *= o.lambda_up
             if self.lam > o.lambda_max:  # no decrease at any damping: not a verdict
-                self.accepted, self.lam = False, o.lambda_start
+                self.accepted, self.lam, self.stuck = False, o.lambda_start, True
                 model.local_step(x)
                 return energy, 0.0
         moved = float(np.abs(trial - x).max())
@@ -218,7 +215,12 @@ class Newton(Strategy):
         were no shorter than half the first third's: the steps wander at the
         resolution E can judge, where without this a binding fold at a tight
         tolerance ran its whole budget; steps that still shrink are converging
-        and go on (`docs/architecture.md#newton`)."""
+        and go on (`docs/architecture.md#newton`). Also a step that no damping made
+        lower E (with K unchanged the next one would be the same, each up to ~25
+        factorisations): the convergence test then certifies the state or calls
+        it stalled."""
+        if self.stuck and not self.model.pins.fading():
+            return True
         steps = self.options.stall_steps
         if self.level < steps:
             return False
@@ -236,156 +238,23 @@ class Newton(Strategy):
     def hessian(self, targets: np.ndarray, touch=None) -> np.ndarray:
         """Values of H = K ⊗ I₃ − Σ w Q Qᵀ (+ ½∇²C of the contacts ``touch``) at the
         projections ``targets`` (nnz, 3) mm, in the fixed pattern of
-        :class:`HessianPattern` (built anew when K changes or a contact block joins)."""
-        system = self.model.system
-        bases = list(self.rotation_bases(targets))
-        ids = [ids for ids, _, _ in bases]
-        blocks = [-weights[:, None, None] * np.matmul(basis, basis.transpose(0, 2, 1))
-                  for _, weights, basis in bases]
-        version = (system.version, 0)
-        if touch is not None:
-            runs, values = self.contact.blocks(touch)
-            ids, blocks = ids + runs, blocks + values
-            version = (system.version, self.contact.version)
-        if self.hessian_pattern is None or self.hessian_pattern.version != version:
-            self.hessian_pattern = HessianPattern(system, ids, version)
-            self._factor = None
-        return self.hessian_pattern.values(blocks)
+        :class:`~foldcore.model.linearisation.HessianPattern` (built anew when K
+        changes or a contact block joins)."""
+        if touch is None:
+            return self.linear.hessian(targets)
+        runs, values = self.contact.blocks(touch)
+        return self.linear.hessian(targets, runs, values, self.contact.version)
+
+    @property
+    def hessian_pattern(self):
+        """The :class:`~foldcore.model.linearisation.HessianPattern` of the last
+        :meth:`hessian` (None before)."""
+        return self.linear.pattern
 
     def _solve(self, values: np.ndarray, rhs: np.ndarray) -> np.ndarray:
-        """(H + λ D)⁻¹ rhs, D the diagonal of K ⊗ I₃; the factor keeps its symbolic
-        analysis while the pattern stays (CHOLMOD ``cholesky_inplace``)."""
-        matrix = self.hessian_pattern.matrix(values, self.lam)
-        if self._factor is None:
-            self._factor = Factor(matrix, self.model.system.backend, stored="lower")
-        else:
-            self._factor.refactor(matrix)
-        return self._factor.solve(rhs)
+        """(H + λ D)⁻¹ rhs, D the diagonal of K ⊗ I₃ (:meth:`Linearisation.solve`)."""
+        return self.linear.solve(values, rhs, self.lam)
 
     def rotation_bases(self, all_targets: np.ndarray):
-        """Per group and element size m: vertex ids (n, m), weights (n,) and an
-        orthonormal basis (n, 3m, 3) of the rotations of each element's projection
-        (``all_targets``: every group's slot targets, mm)."""
-        model = self.model
-        for state, weights in zip(model.groups, model.system.weights):
-            group = state.group
-            sizes = np.diff(group.indptr)
-            targets = all_targets[state.slots]
-            slack = slack_directions(model.x, state) if state is model.hinges else None
-            for m in np.unique(sizes):
-                sel = np.flatnonzero(sizes == m)
-                slots = group.indptr[sel][:, None] + np.arange(m)
-                p = targets[slots]
-                p = p - p.mean(axis=1, keepdims=True)
-                zero = np.zeros_like(p[..., 0])
-                turns = np.stack([np.stack([zero, -p[..., 2], p[..., 1]], axis=2),
-                                  np.stack([p[..., 2], zero, -p[..., 0]], axis=2),
-                                  np.stack([-p[..., 1], p[..., 0], zero], axis=2)], axis=3)
-                basis, _ = np.linalg.qr(turns.reshape(len(sel), 3 * int(m), 3))
-                if slack is not None:
-                    basis = _with_direction(basis, slack[slots].reshape(len(sel), -1))
-                yield group.indices[slots], weights[sel], basis
-
-
-def slack_directions(x: np.ndarray, hinges):
-    """(nnz, 3) how the projections of the hinge group ``hinges`` move per mm of
-    their slack strips' lengths (:func:`elements.bending_hinge.slack_directions`),
-    or None where no strip is a slack one."""
-    params = hinges.params
-    if not np.any(params[:, MODEL] == SLACK):
-        return None
-    group = hinges.group
-    out = np.zeros((len(group.indices), 3))
-    bending_hinge.slack_directions(x, group.indptr, group.indices, group.rest, params,
-                                   hinges.state, out)
-    return out
-
-
-def _with_direction(basis: np.ndarray, direction: np.ndarray) -> np.ndarray:
-    """``basis`` (n, d, c) orthonormal, with ``direction`` (n, d) orthonormalised
-    against it as one more column (a zero column where it is zero or in the span)."""
-    direction = direction - np.einsum("nij,nj->ni", basis, np.einsum("nij,ni->nj", basis,
-                                                                          direction))
-    norm = np.linalg.norm(direction, axis=1, keepdims=True)
-    scale = np.where(norm > 1e-9, 1.0 / np.maximum(norm, 1e-300), 0.0)
-    return np.concatenate([basis, (direction * scale)[:, :, None]], axis=2)
-
-
-class HessianPattern:
-    """The fixed sparsity pattern of H = K ⊗ I₃ − Σ w Q Qᵀ: its lower triangle in CSC,
-    and where each entry of K ⊗ I₃ and of each element's (3m × 3m) block adds in.
-
-    Built once per K (``system.version``), so a step assembles H by one
-    ``bincount`` instead of SciPy's COO → CSR → sum → CSC conversions, and the
-    pattern, explicit zeros kept, is the same at every step: CHOLMOD reuses its
-    symbolic analysis (about half a whole run's time saved:
-    `docs/architecture.md#newton`).
-
-    Parameters
-    ----------
-    system : foldcore.system.System
-        Its K with the pins (``with_pins``), N × N.
-    blocks : list of (n, m) int arrays
-        Vertex ids of each run of elements of size m, in the order their
-        values will be given to :meth:`values`.
-    version : tuple, optional
-        What the pattern was built for (K's version, the contact blocks' count).
-    """
-
-    def __init__(self, system, blocks, version=None):
-        self.version = (system.version, 0) if version is None else version
-        base = sp.kron(system.with_pins(), sp.identity(3), format="coo")
-        rows, cols = [base.row], [base.col]
-        for ids in blocks:
-            n, m = ids.shape
-            dof = (3 * ids[:, :, None] + np.arange(3)).reshape(n, 3 * m)
-            rows.append(np.repeat(dof, 3 * m, axis=1).ravel())
-            cols.append(np.tile(dof, (1, 3 * m)).ravel())
-        rows, cols = np.concatenate(rows), np.concatenate(cols)
-        lower = rows >= cols  # the entries CHOLMOD reads
-        size = base.shape[0]
-        keys, slot = np.unique(cols[lower].astype(np.int64) * size + rows[lower],
-                               return_inverse=True)
-        #: slot in the CSC data of every entry, in :meth:`values`' order; the upper
-        #: triangle's go to one extra slot that is dropped (no masked copy per step)
-        self.slot = np.full(len(rows), len(keys), dtype=np.int64)
-        self.slot[lower] = slot
-        self.indices = (keys % size).astype(np.int32)
-        self.indptr = np.searchsorted(keys // size, np.arange(size + 1)).astype(np.int32)
-        self.shape = (size, size)
-        self.base_values = base.data
-        self.scale = base.tocsr().diagonal()
-        self.diagonal = self.indptr[:-1]  # the first entry of each lower column: its diagonal
-        if not np.array_equal(self.indices[self.diagonal], np.arange(size)):
-            raise SimulationError("solver 'newton': a vertex without elements (K has a zero "
-                                  "diagonal)")
-
-    def values(self, blocks) -> np.ndarray:
-        """(nnz,) values of H from each run's (n, 3m, 3m) blocks (order of ``blocks``)."""
-        entries = np.concatenate([self.base_values] + [b.ravel() for b in blocks])
-        nnz = len(self.indices)
-        return np.bincount(self.slot, weights=entries, minlength=nnz + 1)[:nnz]
-
-    def matrix(self, values: np.ndarray, damping: float):
-        """Lower triangle of H + ``damping`` × D (D the diagonal of K ⊗ I₃), CSC."""
-        data = values.copy()
-        data[self.diagonal] += damping * self.scale
-        return sp.csc_matrix((data, self.indices, self.indptr), shape=self.shape)
-
-
-def _without_rigid_motion(delta: np.ndarray, x: np.ndarray) -> np.ndarray:
-    """``delta`` (N, 3) mm without its component along the whole sheet's rigid motions
-    (translations and infinitesimal rotations ω × (x − x̄)). Without position targets
-    E does not change along them (the anchor pin follows vertex 0), so H is
-    singular there and a nearly undamped step moves the sheet by rounding, step
-    after step at a constant E (`docs/architecture.md#newton`)."""
-    arm = x - x.mean(axis=0)
-    zero, one = np.zeros(len(x)), np.ones(len(x))
-    modes = [np.column_stack([one, zero, zero]), np.column_stack([zero, one, zero]),
-             np.column_stack([zero, zero, one]),
-             np.column_stack([zero, -arm[:, 2], arm[:, 1]]),
-             np.column_stack([arm[:, 2], zero, -arm[:, 0]]),
-             np.column_stack([-arm[:, 1], arm[:, 0], zero])]
-    basis, _ = np.linalg.qr(np.stack([m.ravel() for m in modes], axis=1))
-    flat = delta.ravel()
-    return (flat - basis @ (basis.T @ flat)).reshape(delta.shape)
+        """:meth:`Linearisation.rotation_bases` of the model."""
+        return self.linear.rotation_bases(all_targets)

@@ -4,9 +4,11 @@ Each run starts with a rigid phase (:mod:`..rigid`) from the current positions
 (one rigid-body engine serves every run: its column layout and factor analysis
 are built once). A rigid step that settles ends the run there: the rigid-body
 model's equilibrium (panels exactly rigid, each passive crease one bounded
-bend). Otherwise the phase ends when an accepted step moves ≤ ``rigid_tol`` ×
-size or after ``rigid_max_steps`` steps, and :mod:`..newton` continues from
-where it stopped on the paper's own energy (:mod:`..lbfgs` on meshes
+bend), where the run's equilibrium certificate finds it the mesh's too; where
+it does not (:meth:`Hybrid.refused`) ``newton`` goes on from it. Otherwise the
+phase ends when an accepted step moves ≤ ``rigid_tol`` × size or after
+``rigid_max_steps`` steps, and :mod:`..newton` continues from where it stopped
+on the paper's own energy (:mod:`..lbfgs` on meshes
 ``newton`` refuses, e.g. stretch hinges). A mesh the rigid phase cannot take
 runs one strategy alone: L-BFGS, or ``newton`` where every elastic face is
 cut into rings, which from the rest state starts on the mesh's rigid-panel
@@ -75,6 +77,7 @@ class Hybrid(Strategy):
         self._start = None  # the rigid phase of a mesh in rings while it runs (RigidStart)
         # slack hinges: the rigid phase holds their strips at their shortest, newton frees them
         self._slack = bool(len(slack_creases(model.mesh)))
+        self._rigid_settled = False  # the last report was the rigid phase's settled state
 
     def _finishing(self) -> Strategy:
         """The strategy after (or instead of) the rigid phase: ``newton`` on a mesh whose
@@ -156,6 +159,7 @@ class Hybrid(Strategy):
         return self.rigid.step()
 
     def report(self, moved: float, limit: float) -> Report:
+        self._rigid_settled = False
         if self._start is not None:
             return Report(moved, settled=self._settled_start(moved, limit),
                           stalled=self.stalled)
@@ -197,8 +201,25 @@ class Hybrid(Strategy):
                 self._finish_with_newton()
                 log.info("hybrid: rigid phase ends unsettled after %d steps; %s finishes",
                          self._rigid_steps, self.finish.name)
+            self._rigid_settled = done
             self._leave_rigid_phase()
         return done
+
+    def refused(self) -> bool:
+        """The convergence test refused a settled state. Where the rigid phase settled
+        it, the rigid-body model's equilibrium is not the mesh's (a binding fold its
+        panels resolve by bending, a passive crease its bounds hold): ``newton`` (or
+        the default finish where it refuses the mesh) goes on from it. Else the
+        finishing strategy says."""
+        if not self._rigid_settled:
+            return self.finish.refused()
+        self._rigid_settled = False
+        self._engine.refused()  # no run end to extrapolate from, no twin to continue
+        self._finish_with_newton()
+        self.finish.restart()
+        log.info("hybrid: the rigid phase's equilibrium is not the mesh's; %s finishes",
+                 self.finish.name)
+        return True
 
     def _finish_with_newton(self) -> None:
         """After a rigid phase that handed over unsettled, ``newton`` finishes (where it

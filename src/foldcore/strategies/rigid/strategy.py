@@ -66,6 +66,7 @@ class Rigid(Strategy):
     name = "rigid"
     Options = RigidOptions
     supports_contact = True
+    own_model = True  # its verdict is the rigid-body model's, which the user chose
 
     def __init__(self, model, progress, options=None, predictor: bool = False):
         super().__init__(model, progress, options)
@@ -216,6 +217,16 @@ class Rigid(Strategy):
             self._handed_x = self.engine.x.copy()  # the next run may go on on it
             return True
         self._drop_twin()  # the mesh's own steps finish
+        return False
+
+    def refused(self) -> bool:
+        """The rigid-body model's equilibrium is not the mesh's (every element free: a
+        binding fold its panels resolve by bending, a passive crease its bounds
+        hold), where a composite that steps this strategy first is certified on the
+        mesh (``hybrid``): these steps cannot leave it (False), and the state is no
+        run end to extrapolate from."""
+        self.engine.forget_ends()
+        self._drop_twin()
         return False
 
     def predict(self, ratio: float) -> bool:
