@@ -444,7 +444,7 @@ def _why(result) -> str:
     """Why a run ended unconverged, in words (Result.reason and residual)."""
     far = ("" if math.isnan(result.residual) else  # NaN: never estimated
            f", the equilibrium estimated {result.residual:.1e} × the pattern size away")
-    return {"stalled": "stalled: steps within the tolerance" + far,
+    return {"stalled": "stalled: no step of the strategy reaches the equilibrium" + far,
             "budget": "--max-iterations reached" + far,
             "callback": "stopped"}.get(result.reason, result.reason)
 
