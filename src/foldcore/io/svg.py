@@ -193,7 +193,7 @@ def _element_segments(element, name: str, source: str) -> list:
         a = _point(seg.start, name, source)
         b = _point(seg.end, name, source)
         if not isinstance(seg, (Line, Close)):
-            _check_straight(seg, name, source)
+            _check_straight(seg, np.array(a), np.array(b), name, source)
         if a != b:
             out.append((a, b))
     return out
@@ -289,11 +289,9 @@ def _opacity(element, name: str, source: str) -> float:
     return float(np.clip(number("opacity", 1.0) * stroke, 0.0, 1.0))
 
 
-def _check_straight(seg, name: str, source: str) -> None:
-    """A Bézier or arc segment is read as its chord only if it is one (its points at
-    a few parameters lie on the chord)."""
-    a = np.array([seg.start.x, seg.start.y], dtype=float)
-    b = np.array([seg.end.x, seg.end.y], dtype=float)
+def _check_straight(seg, a: np.ndarray, b: np.ndarray, name: str, source: str) -> None:
+    """A Bézier or arc segment from ``a`` to ``b`` (px, its checked ends) is read as
+    its chord only if it is one (its points at a few parameters lie on the chord)."""
     chord = b - a
     length = float(np.hypot(*chord))
     for t in (0.25, 0.5, 0.75):
