@@ -226,6 +226,12 @@ sys.exit(run())
 """
 
 
+def python(script: str) -> subprocess.CompletedProcess:
+    """``python -c script`` in a process of its own, its output captured as text."""
+    return subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                          timeout=300)
+
+
 @pytest.mark.parametrize("module", ["foldcore.cli", "foldcore.scenes"],
                          ids=["starting", "parsing"])
 @pytest.mark.parametrize("name, code", [("SIGINT", 130), ("SIGTERM", 143)])
@@ -236,8 +242,7 @@ def test_a_signal_while_the_command_starts_is_one_line(module, name, code, hinge
     nothing."""
     script = SIGNAL_AT_IMPORT.format(module=module, signal=name, pattern=str(hinge_file),
                                      out=str(out / "o.fold"))
-    proc = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
-                          timeout=300)
+    proc = python(script)
     assert proc.returncode == code, (proc.returncode, proc.stderr)
     assert "Traceback" not in proc.stderr
     (line,) = proc.stderr.splitlines()
@@ -256,8 +261,7 @@ def test_a_signal_after_the_command_leaves_its_exit_code(tmp_path):
               "os.kill(os.getpid(), signal.SIGTERM)\n"
               "time.sleep(0.5)\n"
               "sys.exit(code)\n")
-    proc = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
-                          timeout=300)
+    proc = python(script)
     assert proc.returncode == 0 and proc.stderr == "", (proc.returncode, proc.stderr)
 
 
@@ -278,8 +282,7 @@ def test_a_signal_lost_in_a_callback_from_c_is_sent_again():
               "        print('lost')\n"
               "    except interrupts.Terminated:\n"
               "        print('raised')\n")
-    proc = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
-                          timeout=300)
+    proc = python(script)
     assert proc.stdout.split() == ["raised"] and proc.stderr == "", proc
 
 
