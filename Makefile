@@ -25,10 +25,10 @@ $(STAMP): pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip
 	@if ./.ci/system-deps --check; then \
-	    $(PY) -m pip install --quiet -e ".[cholmod,render,export,contact,dev]"; \
+	    $(PY) -m pip install --quiet -e ".[cholmod,render,export,contact,study,dev]"; \
 	else \
 	    echo "foldcore: SuiteSparse headers missing: installing without CHOLMOD (SciPy fallback)"; \
-	    $(PY) -m pip install --quiet -e ".[render,export,contact,dev]"; \
+	    $(PY) -m pip install --quiet -e ".[render,export,contact,study,dev]"; \
 	fi
 	$(PY) -m foldcore.warmup
 	touch $(STAMP)

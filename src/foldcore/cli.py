@@ -1,15 +1,13 @@
 """Command line: ``foldcore simulate PATTERN [options]``, ``foldcore render RESULT.fold -o
 OUT.png [options]``, ``foldcore export RESULT.fold --svg/--dxf/--stl OUT``,
 ``foldcore view RESULT.fold -o OUT.html`` (:mod:`foldcore.view`),
-``foldcore scene NAME [--out DIR] [--render]`` (the paper's scenes, :mod:`foldcore.scenes`).
+``foldcore scene NAME [--out DIR] [--render]`` (the paper's scenes, :mod:`foldcore.scenes`),
+``foldcore sweep`` / ``optimize`` (design studies on Dask, :mod:`foldcore.study.commands`).
 
-``simulate --animate OUT.gif|OUT.mp4`` also folds the pattern from 0 to
-``--fold-percent`` in ``--frames`` steps (each continuing the previous state)
-and encodes the rendered frames (:mod:`foldcore.animate`); the outputs of the
-run are those of the last frame. ``render`` and ``export`` read a FOLD written
-by ``simulate -o`` and rebuild its thick mesh (:func:`foldcore.fabrication.
-read_result`); pass them the ``--hinge-width``/``--subdivisions`` given to
-``simulate`` when these cannot be recovered from the file.
+``simulate --animate OUT.gif|OUT.mp4`` also encodes the fold from 0 to
+``--fold-percent`` in ``--frames`` steps (:mod:`foldcore.animate`). ``render`` and
+``export`` rebuild the thick mesh of a FOLD written by ``simulate -o``
+(:func:`foldcore.fabrication.read_result`).
 
 Exit codes: 0 success (a run that ends unconverged — stalled or at
 --max-iterations — is a result: exit 0, ``converged: false`` with its
@@ -33,11 +31,11 @@ from .actuation import ACTUATIONS, BRANCH_FLOOR_DEG, DEFAULT_ACTUATION
 from .destinations import check_destinations
 from .errors import FoldcoreError
 from . import interrupts
-from .interrupts import EXIT_SIGINT
 from .limits import (CELL_RATIO, GROUND_RATIO, LENGTH_MM, MARGIN_RATIO, MAX_ELASTIC_VERTICES,
                      MAX_ITERATIONS, MAX_MESH_VERTICES, STROKE_RATIO, SUBDIVISIONS,
                      THICKNESS_RATIO, TOLERANCE, WIDTH_RATIO)
 from .options import CONTACT_CHOICES, MAX_FPS, MAX_FRAMES
+from .study import commands as study_commands
 from .strategies import DEFAULT_SOLVER, SOLVERS
 
 EXIT_BAD_INPUT = 2
@@ -64,21 +62,22 @@ def _subdivisions(text: str):
     return value
 
 
-def _positive(text: str) -> float:
+def _number(text: str) -> float:
     try:
-        value = float(text)
+        return float(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f"expected a number, got {text!r}")
+
+
+def _positive(text: str) -> float:
+    value = _number(text)
     if not value > 0 or value == float("inf"):
         raise argparse.ArgumentTypeError(f"expected a positive finite number, got {text}")
     return value
 
 
 def _non_negative(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}")
+    value = _number(text)
     if not 0 <= value < float("inf"):
         raise argparse.ArgumentTypeError(f"expected a finite number ≥ 0, got {text}")
     return value
@@ -135,6 +134,7 @@ def build_parser() -> argparse.ArgumentParser:
     view.add_argument("result", help="FOLD file written by foldcore simulate -o / --series")
     view.add_argument("-o", "--output", required=True, help="HTML page to write")
     _add_scene(sub)
+    study_commands.add_to(sub)
     for command in sub.choices.values():
         command.add_argument("-v", "--verbose", action="count", default=0,
                              help="log what the run does (stages, phase hand-overs, "
@@ -358,7 +358,7 @@ def simulate(args) -> int:
             print("foldcore: interrupted (SIGINT) while the finished result was written; "
                   f"its outputs were completed first ({written or 'none asked for'})",
                   file=sys.stderr)
-        return EXIT_SIGINT
+        return interrupts.EXIT_SIGINT
     finally:
         if progress is not None:
             progress.close()
@@ -507,7 +507,7 @@ def view_result(args) -> int:
 
 
 COMMANDS = {"simulate": simulate, "render": render_result, "export": export_result,
-            "view": view_result, "scene": run_scene}
+            "view": view_result, "scene": run_scene, **study_commands.COMMANDS}
 
 
 def _say_warnings(caught: list) -> None:

@@ -121,8 +121,7 @@ def fold(path, *, hinges=None, reading=None, thickening=None, solving=None, outp
     from .outputs import run_summary, write_result
 
     job = Job.make(path, hinges, reading, thickening, solving, outputs)
-    loaded, thickness = _prepared(job)
-    mesh, sim = _simulation(job, loaded, thickness)
+    loaded, thickness, mesh, sim = prepare(job)
     if on_start is not None:
         on_start()
     out, s = job.outputs, job.solving
@@ -144,7 +143,7 @@ def fold(path, *, hinges=None, reading=None, thickening=None, solving=None, outp
                                 elastic=bool(mesh.elastic))
     for text in said:
         warnings.warn(text, RunWarning, stacklevel=3)
-    settings = _settings(job, thickness, mesh, sim)
+    settings = run_settings(job, thickness, mesh, sim)
     with interrupts_deferred() as late:
         write_result(result, loaded.pattern, mesh, thickness, settings, fold=out.fold,
                      report=out.report, png=out.render, partial=interrupted,
@@ -181,6 +180,14 @@ def interrupts_deferred():
         yield received
     finally:
         signal.signal(signal.SIGINT, previous)
+
+
+def prepare(job: Job) -> tuple:
+    """(loaded, thickness, mesh, sim) of a job: the file read (:class:`foldcore.io.FoldFile`),
+    its thickness (mm), the thick mesh and its :class:`foldcore.Simulation` at the flat
+    state; everything that can fail on the inputs fails before the mesh is built."""
+    loaded, thickness = _prepared(job)
+    return (loaded, thickness, *_simulation(job, loaded, thickness))
 
 
 def _prepared(job: Job):
@@ -242,7 +249,7 @@ def _obstacles(s, pattern) -> list:
     return out
 
 
-def _settings(job: Job, thickness: float, mesh, sim) -> dict:
+def run_settings(job: Job, thickness: float, mesh, sim) -> dict:
     """What the report records of the run's settings."""
     s, t = job.solving, job.thickening
     return {"pattern": job.source, "fold_percent": s.fold_percent, "solver": s.solver,

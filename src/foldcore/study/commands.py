@@ -1,0 +1,155 @@
+"""``foldcore sweep``: a design study from the command line (:func:`foldcore.study.sweep`).
+
+``foldcore sweep PATTERN --set NAME=V1,V2,… [--set …] -o results.csv|.parquet``
+folds every combination of the values (or the points of ``--points CSV``) on
+Dask: an embedded LocalCluster (``--workers N``, default one per core) or a
+running scheduler (``--scheduler tcp://HOST:PORT``). PATTERN is a file or a
+built-in generator's name (``miura``: ``--set n=4 --set gamma=50,60``).
+Exit codes as ``simulate``: 2 with one line for bad input (before any fold),
+130 on Ctrl-C (the finished points are cached: the same command resumes).
+Importing this module imports neither Dask nor pandas.
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+
+from ..errors import FoldcoreError
+
+EXIT_SIGINT = 130
+
+
+def add_to(sub) -> None:
+    """Add ``sweep`` to the command line's subparsers."""
+    from .source import GENERATORS
+
+    sweep = sub.add_parser("sweep", help="fold a pattern over a grid of option values "
+                                         "(a design study, on Dask)")
+    sweep.add_argument("pattern", help="crease pattern file, or a generator: "
+                                       + ", ".join(GENERATORS))
+    sweep.add_argument("--set", action="append", default=[], metavar="NAME=V1,V2,…",
+                       help="values of an option (thickness, hinge-width, fold-percent, "
+                            "solver, … as simulate's flags without --) or of the "
+                            "generator's parameters; every combination is a point")
+    sweep.add_argument("--points", metavar="CSV", help="the points as a CSV file "
+                                                       "(header: names; a row per point)")
+    sweep.add_argument("-o", "--output", required=True,
+                       help="the table: .csv, or .parquet (pyarrow)")
+    sweep.add_argument("--hinges", help="hinge file of an OBJ/STL pattern")
+    add_execution(sweep)
+    sweep.add_argument("--keep", metavar="DIR", help="write each point's result FOLD "
+                                                     "here (column result_fold)")
+    sweep.add_argument("--from-flat", action="store_true",
+                       help="fold every point from the flat sheet (default: points equal "
+                            "but for --set fold-percent continue one from the other)")
+    sweep.add_argument("--metric", metavar="FILE.py:FUNCTION",
+                       help="your metric of each fold: FUNCTION(fold) → number or dict "
+                            "(columns), from a Python file or module:function")
+
+
+def add_execution(parser) -> None:
+    """Where a study runs and what it keeps (sweep, optimize)."""
+    parser.add_argument("--scheduler", metavar="tcp://HOST:PORT",
+                        help="run on this Dask scheduler's workers (default: an embedded "
+                             "LocalCluster)")
+    parser.add_argument("--workers", type=_workers, metavar="N",
+                        help="worker processes of the embedded cluster (default: one per "
+                             "core; 0: no cluster, this process)")
+    parser.add_argument("--cache", metavar="DIR", help="finished points, for resuming "
+                                                       "(default: ~/.cache/foldcore/study)")
+    parser.add_argument("--no-cache", action="store_true",
+                        help="neither read nor write finished points")
+    parser.add_argument("-q", "--quiet", action="store_true",
+                        help="no progress bar and no summary line")
+
+
+def _workers(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        value = -1
+    if not 0 <= value <= 1024:
+        raise argparse.ArgumentTypeError(f"expected an integer in 0..1024, got {text!r}")
+    return value
+
+
+def run_sweep(args) -> int:
+    """Run ``foldcore sweep``; raises FoldcoreError on bad input."""
+    from ..destinations import check_destinations
+    from . import points as pts
+    from .sweep import sweep
+    from .table import TABLE_SUFFIXES, write_table
+
+    if bool(args.set) == bool(args.points):
+        raise pts.StudyError("give the points with --set NAME=V1,V2,… or --points CSV "
+                             "(one of them)")
+    check_destinations({"-o": args.output}, inputs=(args.pattern, args.points, args.hinges),
+                       suffixes={"-o": TABLE_SUFFIXES})
+    grid = dict(map(pts.parse_set, args.set)) if args.set else None
+    if grid is not None and len(grid) < len(args.set):
+        raise pts.StudyError("a name is given to --set twice")
+    points = pts.read_points(args.points) if args.points else None
+    start = time.perf_counter()
+    try:
+        frame = sweep(args.pattern, grid, points, hinges=args.hinges,
+                      metric=load_metric(args.metric) if args.metric else None,
+                      **execution(args), keep=args.keep, continuation=not args.from_flat)
+    except KeyboardInterrupt:
+        print("foldcore: interrupted (SIGINT); the points that finished are cached: the "
+              "same command folds only the others", file=sys.stderr)
+        return EXIT_SIGINT
+    write_table(frame, args.output)
+    if not args.quiet:
+        print(summary(frame, time.perf_counter() - start, args.output), file=sys.stderr)
+    return 0
+
+
+def execution(args) -> dict:
+    """The study's execution options from the flags."""
+    return {"scheduler": args.scheduler, "workers": args.workers,
+            "cache": None if args.no_cache else (args.cache or "default"),
+            "progress": False if args.quiet else None}
+
+
+def summary(frame, seconds: float, output) -> str:
+    """One line: points, folded / cached / failed, workers, time, the table's path."""
+    failed = int((frame["error"] != "").sum())
+    cached = int(frame["cached"].fillna(False).sum())
+    workers = frame.loc[~frame["cached"].fillna(False), "worker"].nunique()
+    return (f"foldcore: sweep: {len(frame)} points ({len(frame) - cached - failed} folded on "
+            f"{workers} worker{'s' if workers != 1 else ''}, {cached} from the cache, "
+            f"{failed} failed) in "
+            f"{seconds:.3g} s → {output}")
+
+
+def load_metric(spec: str):
+    """The function of ``FILE.py:FUNCTION`` or ``module:FUNCTION`` (shipped to the
+    workers by value when it comes from a file)."""
+    import importlib
+    import importlib.util
+    from pathlib import Path
+
+    where, _, name = spec.rpartition(":")
+    if not where or not name:
+        raise FoldcoreError(f"--metric {spec!r}: expected FILE.py:FUNCTION or module:FUNCTION")
+    try:
+        if where.endswith(".py"):
+            spec_ = importlib.util.spec_from_file_location(f"foldcore_metric_{Path(where).stem}",
+                                                           where)
+            module = importlib.util.module_from_spec(spec_)
+            spec_.loader.exec_module(module)
+            import cloudpickle
+            cloudpickle.register_pickle_by_value(module)
+        else:
+            module = importlib.import_module(where)
+    except (OSError, ImportError, SyntaxError) as exc:
+        raise FoldcoreError(f"--metric {spec}: cannot load {where}: {exc}") from None
+    function = getattr(module, name, None)
+    if not callable(function):
+        raise FoldcoreError(f"--metric {spec}: {where} has no function {name!r}")
+    return function
+
+
+#: Command name → function, for the command line's dispatch.
+COMMANDS = {"sweep": run_sweep}

@@ -1,0 +1,79 @@
+"""A study row's figures of one fold: what ``foldcore simulate`` reports, flattened.
+
+Every figure is a number, a bool or a short string, so a row is one line of a
+CSV file. Units: mm, degrees, seconds; strains dimensionless.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+
+def figures(result, pattern, mesh) -> dict:
+    """The figures of ``result`` (:class:`foldcore.Result`) folded from ``pattern`` on
+    ``mesh``.
+
+    Returns
+    -------
+    dict
+        ``converged``, ``reason``, ``iterations``, ``residual``; ``run_s`` (the
+        run's own time, set-up excluded), ``setup_s``; ``miss_max_deg``,
+        ``miss_median_deg`` (driven creases' |achieved − target|, as the
+        report's actuation), ``driven``, ``binding``; ``largest_strain``
+        (sub-strips' largest |surface strain|, NaN without hinges),
+        ``fractured`` (hinges past their strain limits), ``largest_overlap_mm``
+        (panels' largest interpenetration at a crease); ``contact_pairs``,
+        ``smallest_gap_mm``, ``touching_panels`` (NaN with contact off); and the
+        folded solid's ``bbox_x_mm``, ``bbox_y_mm``, ``bbox_z_mm`` and
+        ``stack_height_mm`` (its least extent along its principal axes: the
+        stack's height when folded flat).
+    """
+    from ..outputs import actuation_entries
+    from ..measure import crease_overlaps
+
+    act = actuation_entries(result, pattern)
+    timings = result.timings_s
+    strains = result.strip_strains
+    row = {"converged": bool(result.converged), "reason": result.reason,
+           "iterations": int(result.iterations), "residual": _number(result.residual),
+           "run_s": timings.get("projection", 0.0) + timings.get("solve", 0.0),
+           "setup_s": timings.get("setup", math.nan),
+           "miss_max_deg": act["largest_miss_deg"], "miss_median_deg": act["median_miss_deg"],
+           "driven": len(act["creases"]), "binding": act["binding"],
+           "largest_strain": float(np.abs(strains).max()) if strains is not None
+           and len(strains) else math.nan,
+           "fractured": len(result.failures),
+           "largest_overlap_mm": float(np.nanmax(crease_overlaps(pattern, mesh,
+                                                                 result.positions),
+                                                 initial=0.0))}
+    row.update(_contact(result.contact))
+    row.update(extents(result.positions))
+    return row
+
+
+def _number(value) -> float:
+    value = float(value)
+    return value if math.isfinite(value) else math.nan
+
+
+def _contact(contact: dict | None) -> dict:
+    if contact is None:
+        return {"contact_pairs": math.nan, "smallest_gap_mm": math.nan,
+                "touching_panels": math.nan}
+    gap = contact.get("smallest_gap_mm")
+    return {"contact_pairs": len(contact.get("active_pairs", [])),
+            "smallest_gap_mm": math.nan if gap is None else float(gap),
+            "touching_panels": len(contact.get("touching_faces", []))}
+
+
+def extents(positions: np.ndarray) -> dict:
+    """Bounding box of the solid in the pattern's frame and its least principal extent
+    (mm), of (N, 3) vertex positions."""
+    span = positions.max(axis=0) - positions.min(axis=0)
+    centred = positions - positions.mean(axis=0)
+    _, _, axes = np.linalg.svd(centred, full_matrices=False)
+    along = centred @ axes.T
+    principal = along.max(axis=0) - along.min(axis=0)
+    return {"bbox_x_mm": float(span[0]), "bbox_y_mm": float(span[1]),
+            "bbox_z_mm": float(span[2]), "stack_height_mm": float(principal.min())}

@@ -1,0 +1,159 @@
+"""What a study folds: a pattern file (shipped to each worker once) or a generator.
+
+A :class:`PatternFile` carries the file's bytes (and its hinge file's, for
+OBJ/STL), so a worker on another machine needs no shared disk: it writes them
+once into a folder of its own and folds that copy under the same name. A
+:class:`Generator` builds the pattern from a point's parameters on the worker
+(:data:`GENERATORS`: the built-in ones by name, or any function returning a
+:class:`foldcore.CreasePattern`).
+"""
+from __future__ import annotations
+
+import hashlib
+import inspect
+import os
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from .points import StudyError
+
+#: Built-in generators a study can sweep by name (:mod:`foldcore.patterns`).
+GENERATORS = ("miura", "waterbomb", "degree4_vertex", "single_vertex", "grid",
+              "single_hinge", "panel_row", "gripper")
+
+
+@dataclass(frozen=True)
+class PatternFile:
+    """A pattern file's name and bytes (and its hinge file's, if any)."""
+
+    name: str
+    data: bytes = field(repr=False)
+    hinges: bytes | None = field(default=None, repr=False)
+
+    @classmethod
+    def read(cls, path, hinges=None) -> "PatternFile":
+        """Read ``path`` (and its hinge file: ``hinges``, else PATH.hinges for OBJ/STL)
+        after the checks every input gets (:func:`foldcore.files.check_input`)."""
+        from ..files import check_input
+
+        name = os.fspath(path)
+        check_input(name)
+        if hinges is None and Path(name).suffix.lower() in (".obj", ".stl"):
+            guess = Path(name).with_suffix(".hinges")
+            hinges = guess if guess.is_file() else None
+        if hinges is not None:
+            check_input(os.fspath(hinges))
+        return cls(name, Path(name).read_bytes(),
+                   None if hinges is None else Path(hinges).read_bytes())
+
+    @property
+    def label(self) -> str:
+        return self.name
+
+    @property
+    def parameters(self) -> tuple:
+        return ()
+
+    def key(self) -> str:
+        """A hash of the bytes: the cache's key for the pattern."""
+        return hashlib.sha256(self.data + b"\0" + (self.hinges or b"")).hexdigest()
+
+    def materialise(self, params: dict) -> tuple[str, str | None]:
+        """(path, hinge path) of this worker's copy, written on first use."""
+        folder = _worker_folder() / self.key()[:16]
+        path = folder / Path(self.name).name
+        hinge_path = path.with_suffix(".hinges") if self.hinges is not None else None
+        if not path.exists():
+            folder.mkdir(parents=True, exist_ok=True)
+            if hinge_path is not None:
+                hinge_path.write_bytes(self.hinges)
+            path.write_bytes(self.data)
+        return str(path), None if hinge_path is None else str(hinge_path)
+
+
+@dataclass(frozen=True)
+class Generator:
+    """A pattern built from a point's parameters by ``function(**parameters)``."""
+
+    function: object
+    name: str
+
+    @classmethod
+    def named(cls, name: str) -> "Generator":
+        """A built-in generator of :mod:`foldcore.patterns` (``-`` read as ``_``)."""
+        from .. import patterns
+
+        key = name.replace("-", "_")
+        if key not in GENERATORS:
+            raise StudyError(f"{name}: not a pattern file or a generator (generators: "
+                             f"{', '.join(GENERATORS)})")
+        return cls(getattr(patterns, key), key)
+
+    @property
+    def label(self) -> str:
+        return self.name
+
+    @property
+    def parameters(self) -> tuple:
+        """The generator's keyword parameters as the study names them."""
+        return tuple(p.replace("_", "-") for p in inspect.signature(self.function).parameters)
+
+    def key(self) -> str:
+        code = getattr(self.function, "__code__", None)
+        body = code.co_code if code is not None else repr(self.function).encode()
+        return hashlib.sha256(self.name.encode() + b"\0" + body).hexdigest()
+
+    def materialise(self, params: dict) -> tuple[str, str | None]:
+        """(path, None) of a FOLD file of the pattern the parameters make. A pattern
+        without a target angle is written without ``edges_foldAngle``, so its M/V
+        creases fold to ±180° × the fold percent, as such a file's do."""
+        import json
+
+        import numpy as np
+
+        from ..files import write_text
+        from ..io.fold_write import fold_dict
+
+        kwargs = {k.replace("-", "_"): v for k, v in params.items()}
+        try:
+            pattern = self.function(**kwargs)
+        except (TypeError, ValueError) as exc:
+            raise StudyError(f"{self.name}({_args(params)}): {exc}") from None
+        digest = hashlib.sha256(json.dumps(params, sort_keys=True, default=str)
+                                .encode()).hexdigest()[:12]
+        path = _worker_folder() / f"{self.name}-{digest}.fold"
+        if not path.exists():
+            d = fold_dict(pattern)
+            if not np.isfinite(pattern.fold_angles).any():
+                del d["edges_foldAngle"]
+            write_text(path, json.dumps(d, allow_nan=False))
+        return str(path), None
+
+
+def _args(params: dict) -> str:
+    return ", ".join(f"{k}={v!r}" for k, v in params.items())
+
+
+def source_of(pattern, hinges=None):
+    """A :class:`PatternFile` for a path to a file, a :class:`Generator` for a built-in
+    generator's name or a function."""
+    if callable(pattern):
+        return Generator(pattern, getattr(pattern, "__name__", "generator"))
+    text = os.fspath(pattern)
+    if not os.path.exists(text) and text.replace("-", "_") in GENERATORS:
+        return Generator.named(text)
+    if not os.path.exists(text):
+        raise StudyError(f"{text}: no such file, and not a generator (generators: "
+                         f"{', '.join(GENERATORS)})")
+    return PatternFile.read(text, hinges)
+
+
+_FOLDER: list = []
+
+
+def _worker_folder() -> Path:
+    """This process's folder for the patterns it folds (removed when it exits)."""
+    if not _FOLDER:
+        _FOLDER.append(tempfile.TemporaryDirectory(prefix="foldcore-study-"))
+    return Path(_FOLDER[0].name)

@@ -1,0 +1,159 @@
+"""What a worker does: fold one continuation path of a study's points into rows.
+
+A path is a list of points equal but for their fold percent (:func:`foldcore.study.
+points.paths`). Its first point is folded exactly as ``foldcore simulate`` folds
+it (the same :func:`foldcore.job.prepare`, the same ``Simulation.run`` from the
+flat sheet), so its figures equal a direct run's. Each further point continues
+from the previous point's result (:func:`foldcore.animate.fold_sweep`), the
+column ``start`` saying so; its ``iterations`` and ``run_s`` are its own.
+A point that fails is a row with its ``error``: the rest of the path is
+still folded, each from the flat sheet if the failure left no state.
+"""
+from __future__ import annotations
+
+import math
+import time
+import warnings
+
+from .points import FOLD_PERCENT, option_groups
+
+
+def run_path(source, points: list[dict], *, metric=None, keep: bool = False,
+             continuation: bool = True) -> list[dict]:
+    """Rows of a path's points, in order.
+
+    Parameters
+    ----------
+    source : PatternFile or Generator
+        What is folded (:mod:`foldcore.study.source`).
+    points : list of dict
+        Points equal but for ``fold-percent``, in the order to fold them.
+    metric : callable(Fold) -> float or dict, optional
+        The user's metric of each fold (:class:`foldcore.job.Fold`); a float is the
+        column ``metric``, a dict its own columns.
+    keep : bool
+        Add ``result_fold`` (the result FOLD's bytes) to each row.
+    continuation : bool
+        Fold each point after the first from the previous one's result; False:
+        each from the flat sheet (every row then equals its direct run).
+
+    Returns
+    -------
+    list of dict, one row per point: the point, the figures
+    (:func:`foldcore.study.figures.figures`), ``wall_s``, ``start``, ``worker``,
+    ``error`` (empty when the point folded).
+    """
+    worker = worker_address()
+    rows, state = [], None
+    for point in points:
+        start = time.perf_counter()
+        with warnings.catch_warnings(record=True) as said:
+            warnings.simplefilter("always")
+            try:
+                row, state = _fold_point(source, point, state if continuation else None,
+                                         metric, keep)
+            except Exception as exc:  # a failing point is a row, never the end of the study
+                row, state = {"error": error_text(exc)}, None
+        named = _named(source, point)
+        rows.append({**point, **row, "wall_s": time.perf_counter() - start,
+                     "worker": worker, "error": named(row.get("error", "")),
+                     "warnings": "; ".join(dict.fromkeys(named(str(w.message))
+                                                         for w in said))})
+    return rows
+
+
+def _named(source, point: dict):
+    """A message with the worker's copy of the pattern named as the user named it."""
+    import os
+
+    path = source.materialise(_generator_parameters(source, point))[0]
+    return lambda text: text.replace(path, source.label).replace(os.path.dirname(path) + "/",
+                                                                 "")
+
+
+def _fold_point(source, point: dict, state, metric, keep: bool):
+    """(row, state) of one point; ``state`` (job, loaded, thickness, mesh, sim,
+    previous percents) carries a path from one point to the next."""
+    from ..animate import fold_sweep
+    from ..job import Fold, Job, prepare, run_settings
+    from .figures import figures
+
+    path, hinges = source.materialise(_generator_parameters(source, point))
+    job = Job.make(path, hinges, **option_groups(point))
+    if state is None:
+        loaded, thickness, mesh, sim = prepare(job)
+        start, before = "flat", (0, 0.0)
+    else:
+        loaded, thickness, mesh, sim = state[1:5]
+        start, before = f"fold-percent {state[0].solving.fold_percent:g}", _spent(sim)
+    s = job.solving
+    result = fold_sweep(sim, [s.fold_percent], tolerance=s.tolerance,
+                        max_iterations=s.max_iterations, progress=False)[0]
+    row = figures(result, loaded.pattern, mesh)
+    spent = _spent(sim)
+    row.update(iterations=spent[0] - before[0], run_s=spent[1] - before[1], start=start,
+               error="")
+    settings = run_settings(job, thickness, mesh, sim)
+    done = Fold(loaded.pattern, mesh, sim, result, settings, "")
+    if metric is not None:
+        row.update(_metric_columns(metric, done))
+    if keep:
+        row["result_fold"] = _result_bytes(done, thickness)
+    return row, (job, loaded, thickness, mesh, sim)
+
+
+def _spent(sim) -> tuple[int, float]:
+    """(iterations, strategy seconds) the simulation has run so far."""
+    t = sim.timings
+    return sim.iterations, t.get("projection", 0.0) + t.get("solve", 0.0)
+
+
+def _generator_parameters(source, point: dict) -> dict:
+    names = set(source.parameters)
+    return {k: v for k, v in point.items() if k in names}
+
+
+def _metric_columns(metric, done) -> dict:
+    """The metric's columns; its failure is the row's ``metric_error``."""
+    try:
+        value = metric(done)
+    except Exception as exc:
+        return {"metric_error": error_text(exc)}
+    if isinstance(value, dict):
+        return {str(k): v for k, v in value.items()}
+    return {"metric": float(value) if value is not None else math.nan}
+
+
+def _result_bytes(done, thickness: float) -> bytes:
+    """The result FOLD ``foldcore simulate -o`` would write, as bytes."""
+    import tempfile
+    from pathlib import Path
+
+    from ..outputs import write_result
+
+    with tempfile.TemporaryDirectory(prefix="foldcore-keep-") as folder:
+        path = Path(folder) / "result.fold"
+        write_result(done.result, done.pattern, done.mesh, thickness, done.settings,
+                     fold=path)
+        return path.read_bytes()
+
+
+def error_text(exc: BaseException) -> str:
+    """One line: the library's own message, or the exception's type and message."""
+    from ..errors import FoldcoreError
+    from .points import in_names
+
+    text = str(exc).splitlines()[0] if str(exc) else ""
+    if isinstance(exc, FoldcoreError):
+        return in_names(text)
+    return f"{type(exc).__name__}: {text}" if text else type(exc).__name__
+
+
+def worker_address() -> str:
+    """The Dask worker running this task (its address), or ``"local"`` outside one."""
+    try:
+        from distributed import get_worker
+
+        return get_worker().address
+    except (ImportError, ValueError):
+        return "local"
