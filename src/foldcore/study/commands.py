@@ -102,7 +102,16 @@ def run_sweep(args) -> int:
     write_table(frame, args.output)
     if not args.quiet:
         print(summary(frame, time.perf_counter() - start, args.output), file=sys.stderr)
+    say_failures(frame)
     return 0
+
+
+def say_failures(frame) -> None:
+    """A warning line if points failed: how many, and the first one's error."""
+    failed = frame[frame["error"] != ""]
+    if len(failed):
+        print(f"foldcore: warning: {len(failed)} of {len(frame)} points failed (column "
+              f"error; row {failed.index[0]}: {failed['error'].iloc[0]})", file=sys.stderr)
 
 
 def execution(args) -> dict:
@@ -138,6 +147,7 @@ def load_metric(spec: str):
             spec_ = importlib.util.spec_from_file_location(f"foldcore_metric_{Path(where).stem}",
                                                            where)
             module = importlib.util.module_from_spec(spec_)
+            sys.modules[spec_.name] = module  # (cloudpickle ships a registered module)
             spec_.loader.exec_module(module)
             import cloudpickle
             cloudpickle.register_pickle_by_value(module)

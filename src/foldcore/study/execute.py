@@ -60,6 +60,7 @@ def _on_cluster(dask, source, points, plan, metric, keep, continuation, on_rows,
     from distributed import as_completed
 
     shipped = dask.scatter(source, broadcast=True, hash=False)
+    metric = None if metric is None else ByValue(metric)
     dask.run(_warm_worker)
     log.info("study: %d paths on %d workers", len(plan),
              len(dask.scheduler_info(n_workers=-1)["workers"]))
@@ -87,6 +88,30 @@ def _rows_or_error(future, points: list[dict]) -> list[dict]:
         from .task import error_text
 
         return [{**p, "error": f"lost: {error_text(exc)}"} for p in points]
+
+
+class ByValue:
+    """A function shipped by value (cloudpickle), so a metric defined in the user's
+    script or file runs on workers that cannot import it."""
+
+    def __init__(self, function):
+        import cloudpickle
+
+        self.blob = cloudpickle.dumps(function)
+        self.function = None
+
+    def __getstate__(self):
+        return {"blob": self.blob}
+
+    def __setstate__(self, state):
+        self.blob, self.function = state["blob"], None
+
+    def __call__(self, *args):
+        if self.function is None:
+            import cloudpickle
+
+            self.function = cloudpickle.loads(self.blob)
+        return self.function(*args)
 
 
 def _warm_worker() -> float:

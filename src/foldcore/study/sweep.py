@@ -148,10 +148,9 @@ def table(rows: list[dict], names: list[str]):
     extra = [c for row in rows for c in row
              if c not in names and c not in FIGURES and c not in TRAILING]
     columns = names + list(FIGURES) + list(dict.fromkeys(extra)) + list(TRAILING)
-    frame = pd.DataFrame([{c: row.get(c, math.nan) for c in columns} for row in rows],
-                         columns=columns)
-    for text in ("error", "warnings", "result_fold"):
-        frame[text] = frame[text].fillna("")
+    text = ("start", "worker", "result_fold", "warnings", "error")
+    frame = pd.DataFrame([{c: row.get(c, "" if c in text else math.nan) for c in columns}
+                          for row in rows], columns=columns)
     for name, kind in _KINDS.items():  # nullable: a failed point's figures are missing
         frame[name] = frame[name].astype(kind)
     return frame
