@@ -140,6 +140,28 @@ def test_a_metric_adds_its_columns(vertex_file):
     assert frame.loc[0, "crease_1_deg"] == pytest.approx(70.0, abs=0.01)
 
 
+class Trace:
+    """A metric that watches each iteration and gets the point."""
+
+    def __init__(self):
+        self.seen = 0
+
+    def watch(self, sim, moved):
+        self.seen += 1
+
+    def __call__(self, fold, point):
+        seen, self.seen = self.seen, 0
+        return {"watched": seen, "thickness_seen": point["thickness"]}
+
+
+@pytest.mark.parametrize("workers", [0, 1])
+def test_a_metric_can_watch_the_iterations_and_see_its_point(vertex_file, workers):
+    frame = study.sweep(vertex_file, grid={"thickness": [0.1, 0.2]}, metric=Trace(),
+                        workers=workers, cache=None, progress=False)
+    assert list(frame["watched"]) == list(frame["iterations"])
+    assert list(frame["thickness_seen"]) == [0.1, 0.2]
+
+
 def test_a_rerun_takes_finished_points_from_the_cache(vertex_file, tmp_path):
     cache = tmp_path / "cache"
     first = study.sweep(vertex_file, grid=GRID, workers=0, cache=cache, progress=False)
@@ -172,7 +194,7 @@ def test_a_local_cluster_study_runs_on_its_workers(vertex_file):
     from distributed import Client, LocalCluster
 
     with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                      dashboard_address=None, env={"NUMBA_NUM_THREADS": "1"}) as cluster, \
+                      dashboard_address=":0", env={"NUMBA_NUM_THREADS": "1"}) as cluster, \
             Client(cluster) as client:
         workers = set(client.scheduler_info()["workers"])
         frame = study.sweep(vertex_file, grid=GRID, client=client, cache=None)

@@ -3,7 +3,8 @@
 The client is the user's (``client``), one connected to a running scheduler
 (``scheduler="tcp://HOST:PORT"``), or an embedded :class:`distributed.LocalCluster`
 of one single-threaded worker process per core (numba and BLAS on one thread
-each: the points are the parallel work). Before the first point, the
+each: the points are the parallel work; its status page on a free port, not
+8787, which another cluster may hold). Before the first point, the
 pattern (bytes or generator) is scattered to every worker once and each
 worker loads foldcore's compiled kernels once (:func:`foldcore.warmup.warm`).
 Each continuation path is one task; rows are cached as they arrive, so a
@@ -91,8 +92,9 @@ def _rows_or_error(future, points: list[dict]) -> list[dict]:
 
 
 class ByValue:
-    """A function shipped by value (cloudpickle), so a metric defined in the user's
-    script or file runs on workers that cannot import it."""
+    """A metric shipped by value (cloudpickle), so one defined in the user's script or
+    file runs on workers that cannot import it; called as the metric would be
+    (:func:`foldcore.study.task.takes_point`), its ``watch`` passed on."""
 
     def __init__(self, function):
         import cloudpickle
@@ -106,12 +108,22 @@ class ByValue:
     def __setstate__(self, state):
         self.blob, self.function = state["blob"], None
 
-    def __call__(self, *args):
+    def loaded(self):
         if self.function is None:
             import cloudpickle
 
             self.function = cloudpickle.loads(self.blob)
-        return self.function(*args)
+        return self.function
+
+    @property
+    def watch(self):
+        return getattr(self.loaded(), "watch", None)
+
+    def __call__(self, fold, point):
+        from .task import takes_point
+
+        function = self.loaded()
+        return function(fold, point) if takes_point(function) else function(fold)
 
 
 def _warm_worker() -> float:
@@ -140,7 +152,7 @@ def _client(client, scheduler, workers):
     one_thread = {name: "1" for name in ("NUMBA_NUM_THREADS", "OMP_NUM_THREADS",
                                          "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")}
     with _reached("the embedded LocalCluster", lambda: LocalCluster(
-            n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
+            n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0",
             silence_logs=logging.ERROR, env=one_thread)) as cluster, Client(cluster) as dask:
         yield dask
 

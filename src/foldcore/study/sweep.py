@@ -40,10 +40,13 @@ def sweep(pattern, grid: dict | None = None, points: list | None = None, *, hing
         Points given one by one (e.g. :func:`foldcore.study.points.read_points`).
     hinges : path, optional
         Hinge file of an OBJ/STL pattern.
-    metric : callable(Fold) -> float or dict, optional
+    metric : callable(Fold[, point]) -> float or dict, optional
         Evaluated on the worker after each fold (:class:`foldcore.job.Fold`: pattern,
-        mesh, simulation, result); a float becomes the column ``metric``, a dict its
-        own columns. It must be importable or picklable by cloudpickle.
+        mesh, simulation, result; and the point, if it takes a second argument); a
+        float becomes the column ``metric``, a dict its own columns; its optional
+        ``watch(sim, moved_mm)`` is called after each iteration
+        (:func:`foldcore.study.task.run_path`). Shipped to the workers by value
+        (cloudpickle).
     client, scheduler, workers
         Where it runs (:func:`foldcore.study.execute.run_paths`): a
         ``distributed.Client``, a scheduler's address, or an embedded LocalCluster

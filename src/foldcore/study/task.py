@@ -28,9 +28,12 @@ def run_path(source, points: list[dict], *, metric=None, keep: bool = False,
         What is folded (:mod:`foldcore.study.source`).
     points : list of dict
         Points equal but for ``fold-percent``, in the order to fold them.
-    metric : callable(Fold) -> float or dict, optional
-        The user's metric of each fold (:class:`foldcore.job.Fold`); a float is the
-        column ``metric``, a dict its own columns.
+    metric : callable(Fold[, point]) -> float or dict, optional
+        The user's metric of each fold (:class:`foldcore.job.Fold`; with a second
+        positional parameter it also gets the point); a float is the column
+        ``metric``, a dict its own columns. If it has a ``watch(sim, moved_mm)``
+        method, that is called after each iteration of the run (e.g. to record a
+        convergence trace; it must return None or True to go on).
     keep : bool
         Add ``result_fold`` (the result FOLD's bytes) to each row.
     continuation : bool
@@ -49,12 +52,14 @@ def run_path(source, points: list[dict], *, metric=None, keep: bool = False,
         start = time.perf_counter()
         with warnings.catch_warnings(record=True) as said:
             warnings.simplefilter("always")
+            path = None
             try:
-                row, state = _fold_point(source, point, state if continuation else None,
+                path, hinges = source.materialise(_generator_parameters(source, point))
+                row, state = _fold_point(path, hinges, point, state if continuation else None,
                                          metric, keep)
             except Exception as exc:  # a failing point is a row, never the end of the study
                 row, state = {"error": error_text(exc)}, None
-        named = _named(source, point)
+        named = _named(source, path)
         rows.append({**point, **row, "wall_s": time.perf_counter() - start,
                      "worker": worker, "error": named(row.get("error", "")),
                      "warnings": "; ".join(dict.fromkeys(named(str(w.message))
@@ -62,23 +67,23 @@ def run_path(source, points: list[dict], *, metric=None, keep: bool = False,
     return rows
 
 
-def _named(source, point: dict):
-    """A message with the worker's copy of the pattern named as the user named it."""
+def _named(source, path):
+    """A message with the worker's copy of the pattern (``path``) named as the user
+    named it."""
     import os
 
-    path = source.materialise(_generator_parameters(source, point))[0]
+    if path is None:
+        return lambda text: text
     return lambda text: text.replace(path, source.label).replace(os.path.dirname(path) + "/",
                                                                  "")
 
 
-def _fold_point(source, point: dict, state, metric, keep: bool):
-    """(row, state) of one point; ``state`` (job, loaded, thickness, mesh, sim,
-    previous percents) carries a path from one point to the next."""
-    from ..animate import fold_sweep
+def _fold_point(path: str, hinges, point: dict, state, metric, keep: bool):
+    """(row, state) of one point of the pattern file at ``path``; ``state`` (job,
+    loaded, thickness, mesh, sim) carries a path from one point to the next."""
     from ..job import Fold, Job, prepare, run_settings
     from .figures import figures
 
-    path, hinges = source.materialise(_generator_parameters(source, point))
     job = Job.make(path, hinges, **option_groups(point))
     if state is None:
         loaded, thickness, mesh, sim = prepare(job)
@@ -87,16 +92,17 @@ def _fold_point(source, point: dict, state, metric, keep: bool):
         loaded, thickness, mesh, sim = state[1:5]
         start, before = f"fold-percent {state[0].solving.fold_percent:g}", _spent(sim)
     s = job.solving
-    result = fold_sweep(sim, [s.fold_percent], tolerance=s.tolerance,
-                        max_iterations=s.max_iterations, progress=False)[0]
+    sim.set_fold_percent(s.fold_percent)
+    result = sim.run(tolerance=s.tolerance, max_iterations=s.max_iterations,
+                     callback=getattr(metric, "watch", None))
     row = figures(result, loaded.pattern, mesh)
     spent = _spent(sim)
     row.update(iterations=spent[0] - before[0], run_s=spent[1] - before[1], start=start,
-               error="")
+               error="", **({} if state is None else {"setup_s": 0.0}))
     settings = run_settings(job, thickness, mesh, sim)
     done = Fold(loaded.pattern, mesh, sim, result, settings, "")
     if metric is not None:
-        row.update(_metric_columns(metric, done))
+        row.update(_metric_columns(metric, done, point))
     if keep:
         row["result_fold"] = _result_bytes(done, thickness)
     return row, (job, loaded, thickness, mesh, sim)
@@ -113,15 +119,27 @@ def _generator_parameters(source, point: dict) -> dict:
     return {k: v for k, v in point.items() if k in names}
 
 
-def _metric_columns(metric, done) -> dict:
+def _metric_columns(metric, done, point: dict) -> dict:
     """The metric's columns; its failure is the row's ``metric_error``."""
     try:
-        value = metric(done)
+        value = metric(done, point) if takes_point(metric) else metric(done)
     except Exception as exc:
         return {"metric_error": error_text(exc)}
     if isinstance(value, dict):
         return {str(k): v for k, v in value.items()}
     return {"metric": float(value) if value is not None else math.nan}
+
+
+def takes_point(metric) -> bool:
+    """Whether the metric is ``metric(fold, point)`` rather than ``metric(fold)``."""
+    import inspect
+
+    try:
+        params = inspect.signature(metric).parameters.values()
+    except (TypeError, ValueError):
+        return False
+    positional = [p for p in params if p.kind in (p.POSITIONAL_ONLY, p.POSITIONAL_OR_KEYWORD)]
+    return len(positional) >= 2 or any(p.kind == p.VAR_POSITIONAL for p in params)
 
 
 def _result_bytes(done, thickness: float) -> bytes:
