@@ -19,11 +19,17 @@ hinge model (axis, arc, eq8), strategy (hybrid, rigid, lbfgs), actuation
 (the command line's), budget 10 000 iterations (lbfgs on Miura 20 × 20:
 2 000). Wall time = ``Simulation.run`` (set-up excluded), warm numba cache
 (one warm-up fold per model and strategy first), median of RUNS runs (one
-for Miura 20 × 20), the configurations of one case interleaved round by
-round. The ``size`` sweep also records error vs strategy time (set-up +
-projection + solve of ``Simulation.timings``) along each run (``trace``,
-ending with the run's result, as in ``convergence.py``).
-Writes bench/results/accuracy.json and .png.
+for Miura 20 × 20).
+
+Each sweep is a design study (:func:`foldcore.study.sweep`): the patterns are
+the study's generators (:func:`vertex_pattern`, :func:`miura_pattern`), the model, strategy,
+actuation, thickness and budget its points, the error its metric
+(:class:`Error`). Each round folds every point of a sweep once, in this process
+(``workers=0``: one fold at a time, so no other fold disturbs a timing), so the
+rounds interleave the configurations. The ``size`` sweep's metric also records
+error vs strategy time (set-up + projection + solve of ``Simulation.timings``)
+along each run (``trace``, ending with the run's result, as in
+``convergence.py``). Writes bench/results/accuracy.json and .png.
 
 Run: ``python bench/accuracy.py`` (~10 min) or ``--quick``; ``--table`` prints
 the table of docs/benchmarks.md from the JSON.
@@ -31,7 +37,6 @@ the table of docs/benchmarks.md from the JSON.
 from __future__ import annotations
 
 import itertools
-import time
 
 import numpy as np
 
@@ -48,95 +53,149 @@ MIURA_SIZES = (5, 10, 20)
 QUICK = {"runs": 1, "models": ("axis", "arc"), "strategies": ("hybrid", "rigid"),
          "width": (3.0,), "thickness": (1e-2,), "sizes": (5,)}
 R, A = 10.0, 20.0  # mm: vertex disc radius, Miura facet side
+MIURA_H = 1e-3 * A  # mm: the thin Miura's thickness
 STYLE = {"axis": "C0", "arc": "C3", "eq8": "C2"}
 MARKER = {"hybrid": "o-", "rigid": "s--", "lbfgs": "^:"}
 
 
 def vertex(width_over_h: float, h_over_r: float, mode: str = "A"):
-    """Pehrson's vertex, crease 1 → 70°: (pattern, thickness mm, closed form (4,), creases)."""
-    from foldcore import kinematics, patterns
-
-    thickness = h_over_r * R
-    pattern = patterns.degree4_vertex(radius=R, widths=[width_over_h * thickness] * 4,
-                                      mode=mode, rho1=70.0)
-    return pattern, thickness, kinematics.degree4_deg(135.0, 90.0, 70.0, mode), np.arange(4)
+    """Pehrson's vertex, crease 1 → 70°: (pattern, thickness mm, closed form (4,), creases)
+    (the other benchmarks' case)."""
+    expected, creases = closed_form({"mode": mode})
+    return vertex_pattern(width_over_h, h_over_r, mode), h_over_r * R, expected, creases
 
 
 def miura(n: int):
     """Thin Miura n × n, one zig-zag crease driven: (pattern, H, closed form, creases)."""
+    expected, creases = closed_form({"n": n})
+    return miura_pattern(n), MIURA_H, expected, creases
+
+
+def vertex_pattern(w_over_h: float, h_over_r: float, mode: str = "A"):
+    """Pehrson's vertex, crease 1 → 70°, hinge width W/H × H (the study's generator)."""
     from foldcore import patterns
 
-    thickness = 1e-3 * A
-    pattern = patterns.miura_one_crease(n, n, a=A, b=A, width=3 * thickness)
-    creases = np.flatnonzero(patterns.miura_edge_kinds(n, n) != "boundary")
-    return pattern, thickness, patterns.miura_fold_angles(n, n, 60.0, 30.0)[creases], creases
+    thickness = h_over_r * R
+    return patterns.degree4_vertex(radius=R, widths=[w_over_h * thickness] * 4, mode=mode,
+                                   rho1=70.0)
 
 
-def fold(scene, model: str, strategy: str, actuation: str = "equal", budget: int = BUDGET,
-         trace_every: int = 0) -> dict:
-    """One run: error (degrees), iterations, convergence, wall seconds, misfit, trace."""
-    from foldcore import Simulation, thicken
+def miura_pattern(n: int):
+    """Thin Miura n × n, one zig-zag crease driven (the study's generator)."""
+    from foldcore import patterns
 
-    pattern, thickness, expected, creases = scene
-    mesh = thicken(pattern, thickness, hinge=model)
-    sim = Simulation(mesh, pattern, solver=strategy, actuation=actuation)
-    trace = []
+    return patterns.miura_one_crease(n, n, a=A, b=A, width=3 * MIURA_H)
 
-    def record(s, moved):
-        if s.iterations <= 100 or s.iterations % trace_every == 0:
-            t = s.timings
-            error = float(np.abs(s.fold_angles()[creases] - expected).max())
-            trace.append((s.iterations, t["setup"] + t["projection"] + t["solve"], error))
 
-    start = time.perf_counter()
-    result = sim.run(tolerance=TOLERANCE, max_iterations=budget,
-                     callback=record if trace_every else None)
-    seconds = time.perf_counter() - start
-    error = float(np.abs(result.fold_angles_deg[creases] - expected).max())
-    if trace_every:
+def closed_form(point: dict):
+    """(expected angles (°), creases) of a point of either generator."""
+    from foldcore import kinematics, patterns
+
+    if "n" in point:
+        n = point["n"]
+        creases = np.flatnonzero(patterns.miura_edge_kinds(n, n) != "boundary")
+        return patterns.miura_fold_angles(n, n, 60.0, 30.0)[creases], creases
+    return kinematics.degree4_deg(135.0, 90.0, 70.0, point["mode"]), np.arange(4)
+
+
+class Error:
+    """The study's metric: the largest |achieved − closed form| over the creases (°),
+    the hinges' largest misfit (mm) and, when ``trace_every``, the error against
+    strategy time along the run (``trace``: (iteration, s, °), the first 100
+    iterations and every ``trace_every``-th, ending with the result)."""
+
+    def __init__(self, trace_every: int = 0):
+        self.trace_every, self.seen = trace_every, []
+
+    def watch(self, sim, moved):
+        if self.trace_every and (sim.iterations <= 100
+                                 or sim.iterations % self.trace_every == 0):
+            t = sim.timings
+            self.seen.append((sim.iterations, t["setup"] + t["projection"] + t["solve"],
+                              sim.fold_angles()))
+
+    def __call__(self, fold, point):
         from convergence import with_end
 
-        trace = with_end(trace, result, expected, creases)
-    return {"error_deg": error, "iterations": int(result.iterations),
-            "converged": bool(result.converged), "seconds": seconds,
-            "largest_misfit_mm": float(result.hinge_misfit_mm.max()), "trace": trace}
+        expected, creases = closed_form(point)
+        result = fold.result
+        out = {"error_deg": float(np.abs(result.fold_angles_deg[creases] - expected).max()),
+               "largest_misfit_mm": float(result.hinge_misfit_mm.max())}
+        if self.trace_every:
+            trace = [(it, s, float(np.abs(angles[creases] - expected).max()))
+                     for it, s, angles in self.seen]
+            out["trace"] = with_end(trace, result, expected, creases)
+        self.seen = []
+        return out
 
 
-def measure_case(scene, configs: list, runs: int, **where) -> list:
-    """The configurations (model, strategy, actuation, budget, trace_every) of one
-    scene, interleaved over ``runs`` rounds: per configuration its median-time run
-    (``trace`` only where traced) with every run's seconds, and ``where``."""
-    cases = {c: (lambda c=c: fold(scene, c[0], c[1], c[2], c[3], c[4])) for c in configs}
+def configs(q: dict, n: int | None = None) -> list[dict]:
+    """Model × strategy (× actuation for the width sweep) as study options."""
+    out = [{"hinge": m, "solver": s, "actuation": "equal",
+            "max-iterations": 2_000 if (n or 0) >= 20 and s == "lbfgs" else BUDGET}
+           for m, s in itertools.product(q["models"], q["strategies"])]
+    return out
+
+
+def study_points(q: dict) -> dict:
+    """The points of each sweep: {sweep: (generator, [point, …], trace_every)}."""
+    width = [{"w_over_h": r, "h_over_r": 1e-3, "mode": "A", "thickness": 1e-3 * R, **c}
+             for r in q["width"] for c in configs(q)
+             + [{"hinge": m, "solver": "hybrid", "actuation": "angle",
+                 "max-iterations": BUDGET} for m in q["models"]]]
+    thickness = [{"w_over_h": 3.0, "h_over_r": r, "mode": mode, "thickness": r * R, **c}
+                 for r, mode in itertools.product(q["thickness"], "AB") for c in configs(q)]
+    size = [{"n": n, "thickness": MIURA_H, **c} for n in q["sizes"] for c in configs(q, n)]
+    return {"width": (vertex_pattern, width), "thickness": (vertex_pattern, thickness),
+            "size": (miura_pattern, size)}
+
+
+def run_study(generator, points: list, runs: int, traced: bool) -> list:
+    """``runs`` rounds of the study (each round every point once, in this process:
+    timings undisturbed by other workers); per point the median-``run_s`` round's row
+    with every round's ``seconds_runs``."""
+    from foldcore import study
+
+    rounds = [study.sweep(generator, points=points, metric=Error(10 if traced else 0),
+                          workers=0, cache=None, continuation=False, progress=False)
+              for _ in range(runs)]
     rows = []
-    for (model, strategy, actuation, _, traced), runs_ in _meta.interleaved(
-            cases, runs, warmup=0).items():
-        row = _meta.median_run(runs_)
-        if not traced:
-            row.pop("trace")
-        rows.append({**where, **row, "model": model, "strategy": strategy,
-                     "actuation": actuation})
-        print(f"  {where} {model:5s} {strategy:7s} {actuation:6s} err {row['error_deg']:.3g}° "
-              f"its {row['iterations']:5d} {row['seconds']:.3f} s", flush=True)
+    for i, point in enumerate(points):
+        runs_ = [r.iloc[i].to_dict() for r in rounds]
+        assert all(r["error"] == "" for r in runs_), runs_[0]["error"]
+        rows.append({**point, **_row(_meta.median_run(
+            [{**r, "seconds": r["run_s"]} for r in runs_]))})
     return rows
 
 
+def _row(r: dict) -> dict:
+    """A study row in this benchmark's words (JSON: plain numbers)."""
+    out = {"error_deg": float(r["error_deg"]), "iterations": int(r["iterations"]),
+           "converged": bool(r["converged"]), "seconds": float(r["seconds"]),
+           "seconds_runs": [float(x) for x in r["seconds_runs"]],
+           "largest_misfit_mm": float(r["largest_misfit_mm"]), "model": r["hinge"],
+           "strategy": r["solver"]}
+    if isinstance(r.get("trace"), list):
+        out["trace"] = [list(map(float, p)) for p in r["trace"]]
+    return out
+
+
 def sweeps(q: dict) -> dict:
-    """The three sweeps with the settings ``q`` (full or QUICK)."""
-    pairs = list(itertools.product(q["models"], q["strategies"]))
-    width, thickness, size = [], [], []
-    for ratio in q["width"]:
-        configs = [(m, s, "equal", BUDGET, 0) for m, s in pairs]
-        configs += [(m, "hybrid", "angle", BUDGET, 0) for m in q["models"]]
-        width += measure_case(vertex(ratio, 1e-3), configs, q["runs"], width_over_h=ratio)
-    for ratio, mode in itertools.product(q["thickness"], "AB"):
-        configs = [(m, s, "equal", BUDGET, 0) for m, s in pairs]
-        thickness += measure_case(vertex(3.0, ratio, mode), configs, q["runs"],
-                                  h_over_r=ratio, mode=mode)
-    for n in q["sizes"]:
-        configs = [(m, s, "equal", 2_000 if (n >= 20 and s == "lbfgs") else BUDGET,
-                    10 if s != "lbfgs" else 50) for m, s in pairs]
-        size += measure_case(miura(n), configs, 1 if n >= 20 else q["runs"], n=n)
-    return {"width": width, "thickness": thickness, "size": size}
+    """The three sweeps with the settings ``q`` (full or QUICK), each a study."""
+    out = {}
+    for name, (generator, points) in study_points(q).items():
+        big = [p for p in points if p.get("n", 0) >= 20]
+        small = [p for p in points if p.get("n", 0) < 20]
+        rows = run_study(generator, small, q["runs"], name == "size") if small else []
+        rows += run_study(generator, big, 1, True) if big else []
+        for row in rows:
+            print(f"  {name} {row['model']:5s} {row['strategy']:7s} {row['actuation']:6s} "
+                  f"err {row['error_deg']:.3g}° its {row['iterations']:5d} "
+                  f"{row['seconds']:.3f} s", flush=True)
+        out[name] = [{("width_over_h" if k == "w_over_h" else k): v for k, v in r.items()
+                      if k not in ("hinge", "solver", "thickness", "max-iterations")}
+                     for r in rows]
+    return out
 
 
 def plot(data: dict, path) -> None:
@@ -210,8 +269,9 @@ def main() -> None:
     q = QUICK if args.quick else {"runs": RUNS, "models": MODELS, "strategies": STRATEGIES,
                                   "width": WIDTH_RATIOS, "thickness": THICKNESS_RATIOS,
                                   "sizes": MIURA_SIZES}
-    for model, strategy in itertools.product(q["models"], q["strategies"]):  # warm-up
-        fold(vertex(3.0, 1e-3), model, strategy, budget=5)
+    warm = [{"w_over_h": 3.0, "h_over_r": 1e-3, "mode": "A", "thickness": 1e-3 * R,
+             **c, "max-iterations": 5} for c in configs(q)]
+    run_study(vertex_pattern, warm, 1, False)
     record = _meta.Record("accuracy", args, runs=q["runs"], runs_miura_20=1,
                           tolerance=TOLERANCE, budget=BUDGET, budget_lbfgs_miura_20=2_000,
                           others_busy_before=_meta.others_busy())

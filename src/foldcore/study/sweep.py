@@ -67,8 +67,11 @@ def sweep(pattern, grid: dict | None = None, points: list | None = None, *, hing
     Returns
     -------
     pandas.DataFrame
-        Columns: the points' names, :data:`FIGURES` (mm, degrees, seconds), the
-        metric's, then :data:`TRAILING`. ``error`` is empty where the point folded.
+        Columns: the points' names, :data:`FIGURES` (mm, degrees, seconds:
+        ``wall_s`` the whole point on its worker — reading, thickening, run,
+        figures, metric —, ``run_s`` its ``Simulation.run``; the others as
+        :func:`foldcore.study.figures.figures`), the metric's, then :data:`TRAILING`.
+        ``error`` is empty where the point folded.
     """
     from .execute import run_paths
     from .source import source_of

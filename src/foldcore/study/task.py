@@ -87,18 +87,18 @@ def _fold_point(path: str, hinges, point: dict, state, metric, keep: bool):
     job = Job.make(path, hinges, **option_groups(point))
     if state is None:
         loaded, thickness, mesh, sim = prepare(job)
-        start, before = "flat", (0, 0.0)
+        start, before = "flat", 0
     else:
         loaded, thickness, mesh, sim = state[1:5]
-        start, before = f"fold-percent {state[0].solving.fold_percent:g}", _spent(sim)
+        start, before = f"fold-percent {state[0].solving.fold_percent:g}", sim.iterations
     s = job.solving
     sim.set_fold_percent(s.fold_percent)
+    began = time.perf_counter()
     result = sim.run(tolerance=s.tolerance, max_iterations=s.max_iterations,
                      callback=getattr(metric, "watch", None))
-    row = figures(result, loaded.pattern, mesh)
-    spent = _spent(sim)
-    row.update(iterations=spent[0] - before[0], run_s=spent[1] - before[1], start=start,
-               error="", **({} if state is None else {"setup_s": 0.0}))
+    row = {**figures(result, loaded.pattern, mesh), "run_s": time.perf_counter() - began}
+    row.update(iterations=sim.iterations - before, start=start, error="",
+               **({} if state is None else {"setup_s": 0.0}))
     settings = run_settings(job, thickness, mesh, sim)
     done = Fold(loaded.pattern, mesh, sim, result, settings, "")
     if metric is not None:
@@ -106,12 +106,6 @@ def _fold_point(path: str, hinges, point: dict, state, metric, keep: bool):
     if keep:
         row["result_fold"] = _result_bytes(done, thickness)
     return row, (job, loaded, thickness, mesh, sim)
-
-
-def _spent(sim) -> tuple[int, float]:
-    """(iterations, strategy seconds) the simulation has run so far."""
-    t = sim.timings
-    return sim.iterations, t.get("projection", 0.0) + t.get("solve", 0.0)
 
 
 def _generator_parameters(source, point: dict) -> dict:
