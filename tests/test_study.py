@@ -8,7 +8,6 @@ inputs; the workers run numba on one thread, as the direct runs here).
 """
 from __future__ import annotations
 
-import math
 import os
 import signal
 import subprocess

@@ -15,7 +15,7 @@ import math
 import time
 import warnings
 
-from .points import FOLD_PERCENT, option_groups
+from .points import option_groups
 
 
 def run_path(source, points: list[dict], *, metric=None, keep: bool = False,
