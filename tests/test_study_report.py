@@ -322,6 +322,45 @@ def test_thumbnails_off_writes_no_view_page(kept, tmp_path):
     assert "Folded solids" not in (tmp_path / "r.html").read_text()
 
 
+# ---------------------------------------------------------------- command line
+def test_sweep_writes_plots_and_report(tmp_path, capsys):
+    from foldcore.cli import main
+
+    code = main(["sweep", "miura", "--set", "n=2", "--set", "m=2", "--set",
+                 "thickness=0.1,0.2", "--workers", "0", "--no-cache", "-q",
+                 "-o", str(tmp_path / "t.csv"), "--plots", str(tmp_path / "plots"),
+                 "--report", str(tmp_path / "r.html"), "--keep", str(tmp_path / "keep")])
+    assert code == 0, capsys.readouterr().err
+    assert len(list((tmp_path / "plots").glob("*.png"))) == len(report.PLOTTED)
+    assert sorted(p.name for p in (tmp_path / "r_files").iterdir()) == [
+        "point-0000.html", "point-0001.html"]
+    assert_self_contained((tmp_path / "r.html").read_text(), tmp_path / "r.html")
+
+
+@pytest.mark.parametrize("flags, message", [
+    (["--report", "r.pdf"], "--report r.pdf: writes .html or .htm only"),
+    (["--report", "t.csv"], "writes .html or .htm only"),
+    (["--plots", "afile"], "--plots afile: is a file, not a folder"),
+    (["--plots", "nope/plots"], "no such folder"),
+    (["--report", "r.html", "--keep", "k"], "its view pages' folder r_files: is a file"),
+])
+def test_bad_destinations_are_refused_before_any_fold(tmp_path, monkeypatch, capsys, flags,
+                                                      message):
+    import importlib
+
+    from foldcore.cli import main
+
+    sweep_module = importlib.import_module("foldcore.study.sweep")  # not the function
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "afile").write_text("")
+    (tmp_path / "r_files").write_text("")
+    monkeypatch.setattr(sweep_module, "sweep", lambda *a, **k: pytest.fail("folded"))
+    code = main(["sweep", "miura", "--set", "n=2", "-o", "t.csv", *flags])
+    assert code == 2
+    assert message in capsys.readouterr().err
+    assert not (tmp_path / "t.csv").exists()
+
+
 def test_importing_the_study_imports_no_plotting():
     import subprocess
     import sys
