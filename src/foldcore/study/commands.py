@@ -5,6 +5,8 @@ folds every combination of the values (or the points of ``--points CSV``) on
 Dask: an embedded LocalCluster (``--workers N``, default one per core) or a
 running scheduler (``--scheduler tcp://HOST:PORT``). PATTERN is a file or a
 built-in generator's name (``miura``: ``--set n=4 --set gamma=50,60``).
+``--plots DIR`` and ``--report OUT.html`` add what a designer reads
+(:mod:`foldcore.study.report`).
 Exit codes as ``simulate``: 2 with one line for bad input (before any fold),
 130 on Ctrl-C (the finished points are cached: the same command resumes).
 Importing this module imports neither Dask nor pandas.
@@ -46,6 +48,13 @@ def add_to(sub) -> None:
     sweep.add_argument("--metric", metavar="FILE.py:FUNCTION",
                        help="your metric of each fold: FUNCTION(fold) → number or dict "
                             "(columns), from a Python file or module:function")
+    sweep.add_argument("--plots", metavar="DIR",
+                       help="a PNG of each figure against each swept parameter, in DIR "
+                            "(matplotlib)")
+    sweep.add_argument("--report", metavar="OUT.html",
+                       help="one self-contained HTML page: summary, plots, table; with "
+                            "--keep, a picture of each folded solid linking to its view "
+                            "page (in OUT_files/)")
 
 
 def add_execution(parser) -> None:
@@ -78,14 +87,19 @@ def run_sweep(args) -> int:
     """Run ``foldcore sweep``; raises FoldcoreError on bad input."""
     from ..destinations import check_destinations
     from . import points as pts
+    from .report import REPORT_SUFFIXES, check_folders, report_folder, write_plots, write_report
     from .sweep import sweep
     from .table import TABLE_SUFFIXES, write_table
 
     if bool(args.set) == bool(args.points):
         raise pts.StudyError("give the points with --set NAME=V1,V2,… or --points CSV "
                              "(one of them)")
-    check_destinations({"-o": args.output}, inputs=(args.pattern, args.points, args.hinges),
-                       suffixes={"-o": TABLE_SUFFIXES})
+    check_destinations({"-o": args.output, "--report": args.report},
+                       inputs=(args.pattern, args.points, args.hinges),
+                       suffixes={"-o": TABLE_SUFFIXES, "--report": REPORT_SUFFIXES})
+    pages = report_folder(args.report) if args.report and args.keep else None
+    check_folders({"--plots": args.plots,
+                   f"--report {args.report}: its view pages' folder": pages})
     grid = dict(map(pts.parse_set, args.set)) if args.set else None
     if grid is not None and len(grid) < len(args.set):
         raise pts.StudyError("a name is given to --set twice")
@@ -100,6 +114,10 @@ def run_sweep(args) -> int:
               "same command folds only the others", file=sys.stderr)
         return EXIT_SIGINT
     write_table(frame, args.output)
+    plots = write_plots(frame, args.plots) if args.plots else None
+    if args.report:
+        write_report(frame, args.report, pattern_label=args.pattern, plots=plots,
+                     thumbnails=args.keep is not None)
     if not args.quiet:
         print(summary(frame, time.perf_counter() - start, args.output), file=sys.stderr)
     say_failures(frame)
