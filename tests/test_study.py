@@ -333,3 +333,46 @@ def test_an_interrupted_study_resumes_without_refolding(vertex_file, tmp_path):
     frame = pd.read_csv(out)
     assert int(frame["cached"].sum()) == done and len(frame) == 10
     assert f"{10 - done} folded" in err
+
+
+def test_a_generator_that_refuses_its_parameters_is_a_row():
+    frame = study.sweep("miura", grid={"n": [2], "m": [2], "gamma": [50, 95],
+                                       "thickness": [0.1]}, workers=0, cache=None)
+    assert frame.loc[0, "error"] == "" and frame.loc[0, "converged"]
+    assert "miura(" in frame.loc[1, "error"] and "gamma" in frame.loc[1, "error"]
+
+
+def test_a_switch_is_set_as_its_flag_does(vertex_file):
+    frame = study.sweep("miura", grid={"n": [2], "m": [2], "thickness": [0.1],
+                                       "mv-passive": [False, True]}, workers=0, cache=None)
+    assert list(frame["driven"]) == [4, 0]
+    assert "mv-passive=true" in frame.loc[0, "warnings"]
+    with pytest.raises(StudyError, match="mv-passive is true or false"):
+        study.sweep("miura", grid={"thickness": [0.1], "mv-passive": ["yes"]}, workers=0)
+
+
+def test_a_metric_column_may_not_replace_a_figure(vertex_file):
+    frame = study.sweep(vertex_file, grid={"thickness": [0.1]}, workers=0, cache=None,
+                        metric=lambda fold: {"iterations": -1})
+    assert frame.loc[0, "iterations"] > 0
+    assert "'iterations' is a column of the row" in frame.loc[0, "metric_error"]
+
+
+def test_another_constant_in_the_metric_is_another_cache_key(vertex_file, tmp_path):
+    cache = tmp_path / "cache"
+    study.sweep(vertex_file, grid={"thickness": [0.1]}, workers=0, cache=cache,
+                metric=lambda fold: {"under": float(fold.result.iterations < 5)})
+    again = study.sweep(vertex_file, grid={"thickness": [0.1]}, workers=0, cache=cache,
+                        metric=lambda fold: {"under": float(fold.result.iterations < 500)})
+    assert not again["cached"].any() and again.loc[0, "under"] == 1.0
+
+
+def test_keep_refolds_cached_points_without_their_result(vertex_file, tmp_path):
+    cache, keep = tmp_path / "cache", tmp_path / "keep"
+    study.sweep(vertex_file, grid={"thickness": [0.1]}, workers=0, cache=cache)
+    kept = study.sweep(vertex_file, grid={"thickness": [0.1]}, workers=0, cache=cache,
+                       keep=keep)
+    assert not kept["cached"].any() and Path(kept.loc[0, "result_fold"]).is_file()
+    again = study.sweep(vertex_file, grid={"thickness": [0.1]}, workers=0, cache=cache,
+                        keep=keep)
+    assert again["cached"].all() and Path(again.loc[0, "result_fold"]).is_file()

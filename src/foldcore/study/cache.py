@@ -26,14 +26,30 @@ def point_key(source_key: str, point: dict, before: list, metric=None) -> str:
     """The cache key of a point whose path folded ``before`` (fold percents) first."""
     from .. import __version__
 
-    code = getattr(metric, "__code__", None)
     identity = {"version": __version__, "source": source_key, "point": point,
-                "before": before,
-                "metric": None if metric is None else
-                [getattr(metric, "__qualname__", repr(metric)),
-                 hashlib.sha256(code.co_code).hexdigest() if code else ""]}
+                "before": before, "metric": None if metric is None else code_identity(metric)}
     text = json.dumps(identity, sort_keys=True, default=str)
     return hashlib.sha256(text.encode()).hexdigest()[:32]
+
+
+def code_identity(function) -> str:
+    """A hash of what a function (or callable object) computes with: its code with its
+    constants and nested functions (``marshal``), its defaults, and an object's
+    state and its class's methods. Another constant or default is another key;
+    a name alone is not."""
+    import marshal
+
+    parts = []
+    target = function
+    callables = [target]
+    if not hasattr(target, "__code__"):  # an object: its class's methods and its state
+        callables = [v for v in vars(type(target)).values() if hasattr(v, "__code__")]
+        parts.append(repr(sorted(getattr(target, "__dict__", {}).items(), key=str)))
+    for f in callables:
+        parts += [marshal.dumps(f.__code__).hex(), repr(getattr(f, "__defaults__", None)),
+                  repr(getattr(f, "__kwdefaults__", None))]
+    parts.append(getattr(target, "__qualname__", type(target).__qualname__))
+    return hashlib.sha256("\0".join(parts).encode()).hexdigest()
 
 
 class Cache:

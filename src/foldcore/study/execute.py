@@ -45,6 +45,7 @@ def run_paths(source, points: list[dict], plan: list[list[int]], *, metric=None,
     bar = _bar(sum(map(len, plan)), progress)
     try:
         if workers == 0 and client is None and scheduler is None:
+            _warm_worker()  # (else the first point's times would include loading kernels)
             for ids in plan:
                 rows = run_path(source, [points[i] for i in ids], metric=metric, keep=keep,
                                 continuation=continuation)

@@ -20,22 +20,31 @@ from ..options import FLAGS
 #: Option groups a study may set, and the ``simulate`` fields it may not (lists,
 #: outputs: a study writes its own).
 _GROUPS = ("thickening", "solving", "reading")
-_NOT_SWEPT = ("solving.obstacles",)
+_NOT_SWEPT = ("solving.obstacles", "reading.hinges")
 
 
-def _option_table() -> dict:
-    """{study name: (group, field)} from the command line's flags (one table of names)."""
-    out = {}
+def _option_table() -> tuple[dict, dict]:
+    """({study name: (group, field)}, {switch name: (group, field, value when on)}) from
+    the command line's flags (one table of names)."""
+    import ast
+
+    options, switches = {}, {}
     for name, flag in FLAGS.items():
         group, _, field = name.partition(".")
-        if group in _GROUPS and "=" not in field and name not in _NOT_SWEPT \
-                and flag.startswith("--"):
-            out[flag[2:]] = (group, field)
-    return out
+        if group not in _GROUPS or name in _NOT_SWEPT or not flag.startswith("--"):
+            continue
+        if "=" in field:  # a flag without a value: field=value when given
+            field, _, value = field.partition("=")
+            switches[flag[2:]] = (group, field, ast.literal_eval(value))
+        else:
+            options[flag[2:]] = (group, field)
+    return options, switches
 
 
-#: {name: (option group, field)} of every ``simulate`` option a study can set.
-OPTIONS = _option_table()
+#: {name: (option group, field)} of every ``simulate`` option a study can set, and
+#: {name: (group, field, value)} of its switches (``mv-passive=true``: the field is
+#: set to the value, as the flag does; false: the default).
+OPTIONS, SWITCHES = _option_table()
 #: The option whose points run as one continuation path (:func:`paths`).
 FOLD_PERCENT = "fold-percent"
 #: Most points one study may hold (a grid's product is checked before it is made).
@@ -141,6 +150,9 @@ def option_groups(point: dict) -> dict:
         if name in OPTIONS:
             group, field = OPTIONS[name]
             groups[group][field] = value
+        elif name in SWITCHES and value is True:
+            group, field, on = SWITCHES[name]
+            groups[group][field] = on
     return groups
 
 
@@ -154,11 +166,15 @@ def check(points: list[dict], parameters=()) -> list[dict]:
     out = []
     for i, raw in enumerate(points):
         point = {canonical(k): v for k, v in raw.items()}
-        unknown = sorted(set(point) - set(OPTIONS) - set(parameters))
+        unknown = sorted(set(point) - set(OPTIONS) - set(SWITCHES) - set(parameters))
         if unknown:
-            known = sorted(OPTIONS) + sorted(parameters)
+            known = sorted(OPTIONS) + sorted(SWITCHES) + sorted(parameters)
             raise StudyError(f"point {i}: unknown name {unknown[0]!r} (options and "
                              f"parameters: {', '.join(known)})")
+        bad = [n for n in set(point) & set(SWITCHES) if not isinstance(point[n], bool)]
+        if bad:
+            raise StudyError(f"point {i} ({describe(point)}): {bad[0]} is true or false, "
+                             f"got {point[bad[0]]!r}")
         for group, values in option_groups(point).items():
             try:
                 as_group(classes[group], values, group)
@@ -171,6 +187,8 @@ def check(points: list[dict], parameters=()) -> list[dict]:
 
 def in_names(text: str) -> str:
     """A library message with ``group.field`` replaced by the study's name for it."""
+    for name, (group, field, value) in SWITCHES.items():
+        text = text.replace(f"{group}.{field}={value!r}", f"{name}=true")
     for name, (group, field) in sorted(OPTIONS.items(), key=lambda kv: -len(kv[1][1])):
         text = text.replace(f"{group}.{field}", name)
     return text

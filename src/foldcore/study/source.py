@@ -100,9 +100,11 @@ class Generator:
         return tuple(p.replace("_", "-") for p in inspect.signature(self.function).parameters)
 
     def key(self) -> str:
-        code = getattr(self.function, "__code__", None)
-        body = code.co_code if code is not None else repr(self.function).encode()
-        return hashlib.sha256(self.name.encode() + b"\0" + body).hexdigest()
+        """A hash of the generator's name and code (constants and defaults included)."""
+        from .cache import code_identity
+
+        return hashlib.sha256(f"{self.name}\0{code_identity(self.function)}".encode()) \
+            .hexdigest()
 
     def materialise(self, params: dict) -> tuple[str, str | None]:
         """(path, None) of a FOLD file of the pattern the parameters make. A pattern

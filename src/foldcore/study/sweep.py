@@ -86,7 +86,7 @@ def sweep(pattern, grid: dict | None = None, points: list | None = None, *, hing
     missing = []
     for ids in plan:
         hits = [store.get(keys[i]) for i in ids]
-        if all(h is not None for h in hits):
+        if all(h is not None and (keep_dir is None or h[1] is not None) for h in hits):
             for i, (row, fold) in zip(ids, hits):
                 rows[i] = _kept({**row, "cached": True}, fold, keep_dir, i)
         else:

@@ -72,10 +72,12 @@ def _named(source, path):
     named it."""
     import os
 
+    from .points import in_names
+
     if path is None:
-        return lambda text: text
-    return lambda text: text.replace(path, source.label).replace(os.path.dirname(path) + "/",
-                                                                 "")
+        return in_names
+    return lambda text: in_names(text.replace(path, source.label)
+                                 .replace(os.path.dirname(path) + "/", ""))
 
 
 def _fold_point(path: str, hinges, point: dict, state, metric, keep: bool):
@@ -102,7 +104,7 @@ def _fold_point(path: str, hinges, point: dict, state, metric, keep: bool):
     settings = run_settings(job, thickness, mesh, sim)
     done = Fold(loaded.pattern, mesh, sim, result, settings, "")
     if metric is not None:
-        row.update(_metric_columns(metric, done, point))
+        row.update(_metric_columns(metric, done, point, taken={*point, *row}))
     if keep:
         row["result_fold"] = _result_bytes(done, thickness)
     return row, (job, loaded, thickness, mesh, sim)
@@ -113,15 +115,23 @@ def _generator_parameters(source, point: dict) -> dict:
     return {k: v for k, v in point.items() if k in names}
 
 
-def _metric_columns(metric, done, point: dict) -> dict:
-    """The metric's columns; its failure is the row's ``metric_error``."""
+def _metric_columns(metric, done, point: dict, taken=()) -> dict:
+    """The metric's columns; its failure, or a column named as one the row has
+    (``taken``: the point's names, the figures), is the row's ``metric_error``."""
+    from .sweep import FIGURES, TRAILING
+
     try:
         value = metric(done, point) if takes_point(metric) else metric(done)
     except Exception as exc:
         return {"metric_error": error_text(exc)}
-    if isinstance(value, dict):
-        return {str(k): v for k, v in value.items()}
-    return {"metric": float(value) if value is not None else math.nan}
+    if not isinstance(value, dict):
+        return {"metric": float(value) if value is not None else math.nan}
+    columns = {str(k): v for k, v in value.items()}
+    clash = sorted(set(columns) & ({*taken, *FIGURES, *TRAILING, "metric_error"}))
+    if clash:
+        return {"metric_error": f"the metric's column {clash[0]!r} is a column of the row "
+                                "already (a point's name or a figure): rename it"}
+    return columns
 
 
 def takes_point(metric) -> bool:
