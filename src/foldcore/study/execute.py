@@ -69,8 +69,7 @@ def _on_cluster(dask, source, points, plan, metric, keep, continuation, on_rows,
     futures = {}
     for ids in plan:
         future = dask.submit(run_path, shipped, [points[i] for i in ids], metric=metric,
-                             keep=keep, continuation=continuation, pure=False,
-                             key=f"foldcore-path-{ids[0]}-{os.urandom(4).hex()}")
+                             keep=keep, continuation=continuation, pure=False)
         futures[future] = ids
     try:
         for future in as_completed(futures):

@@ -19,8 +19,8 @@ from pathlib import Path
 from .points import StudyError
 
 #: Built-in generators a study can sweep by name (:mod:`foldcore.patterns`).
-GENERATORS = ("miura", "waterbomb", "degree4_vertex", "single_vertex", "grid",
-              "single_hinge", "panel_row", "gripper")
+GENERATORS = ("miura", "miura_one_crease", "waterbomb", "degree4_vertex", "single_vertex",
+              "grid", "single_hinge", "panel_row", "gripper")
 
 
 @dataclass(frozen=True)
