@@ -9,6 +9,15 @@ import math
 
 import numpy as np
 
+#: The figures' columns, in the table's order, after the point's own names.
+FIGURES = ("converged", "reason", "iterations", "wall_s", "run_s", "setup_s",
+           "miss_max_deg", "miss_median_deg", "driven", "binding", "residual",
+           "largest_strain", "fractured", "largest_overlap_mm", "contact_pairs",
+           "smallest_gap_mm", "touching_panels", "bbox_x_mm", "bbox_y_mm", "bbox_z_mm",
+           "stack_height_mm")
+#: The table's columns after the metric's.
+TRAILING = ("start", "worker", "cached", "result_fold", "warnings", "error")
+
 
 def figures(result, pattern, mesh) -> dict:
     """The figures of ``result`` (:class:`foldcore.Result`) folded from ``pattern`` on

@@ -5,20 +5,13 @@ import math
 from pathlib import Path
 
 from .cache import Cache, default_folder, point_key
+from .figures import FIGURES, TRAILING
 from .points import StudyError, check, grid as grid_points, paths as continuation_paths
 
-#: The figures' columns, in the table's order, after the point's own names.
-FIGURES = ("converged", "reason", "iterations", "wall_s", "run_s", "setup_s",
-           "miss_max_deg", "miss_median_deg", "driven", "binding", "residual",
-           "largest_strain", "fractured", "largest_overlap_mm", "contact_pairs",
-           "smallest_gap_mm", "touching_panels", "bbox_x_mm", "bbox_y_mm", "bbox_z_mm",
-           "stack_height_mm")
 #: Figures that are counts or flags (kept so with a failed point's missing values).
 _KINDS = {"converged": "boolean", "binding": "boolean", "cached": "boolean",
           "iterations": "Int64", "driven": "Int64", "fractured": "Int64",
           "contact_pairs": "Int64", "touching_panels": "Int64"}
-#: Columns after the metric's.
-TRAILING = ("start", "worker", "cached", "result_fold", "warnings", "error")
 
 
 def sweep(pattern, grid: dict | None = None, points: list | None = None, *, hinges=None,
@@ -82,15 +75,7 @@ def sweep(pattern, grid: dict | None = None, points: list | None = None, *, hing
     store = Cache(default_folder() if cache == "default" else cache)
     keys = _keys(source.key(), todo, plan, metric)
     keep_dir = _keep_folder(keep)
-    rows: list = [None] * len(todo)
-    missing = []
-    for ids in plan:
-        hits = [store.get(keys[i]) for i in ids]
-        if all(h is not None and (keep_dir is None or h[1] is not None) for h in hits):
-            for i, (row, fold) in zip(ids, hits):
-                rows[i] = _kept({**row, "cached": True}, fold, keep_dir, i)
-        else:
-            missing.append(ids)
+    rows, missing = _from_cache(store, keys, plan, keep_dir)
 
     def arrived(ids, new_rows):
         for i, row in zip(ids, new_rows):
@@ -104,6 +89,21 @@ def sweep(pattern, grid: dict | None = None, points: list | None = None, *, hing
                   continuation=continuation, client=client, scheduler=scheduler,
                   workers=workers, progress=progress, on_rows=arrived)
     return table(rows, list(todo[0]) if todo else [])
+
+
+def _from_cache(store, keys: list, plan: list, keep_dir) -> tuple[list, list]:
+    """(rows, paths still to fold): the rows of every path found whole in the cache
+    (with its result FOLD, when kept), None for the others."""
+    rows: list = [None] * len(keys)
+    missing = []
+    for ids in plan:
+        hits = [store.get(keys[i]) for i in ids]
+        if all(h is not None and (keep_dir is None or h[1] is not None) for h in hits):
+            for i, (row, fold) in zip(ids, hits):
+                rows[i] = _kept({**row, "cached": True}, fold, keep_dir, i)
+        else:
+            missing.append(ids)
+    return rows, missing
 
 
 def _points(grid, points, parameters) -> list[dict]:

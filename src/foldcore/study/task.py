@@ -118,7 +118,7 @@ def _generator_parameters(source, point: dict) -> dict:
 def _metric_columns(metric, done, point: dict, taken=()) -> dict:
     """The metric's columns; its failure, or a column named as one the row has
     (``taken``: the point's names, the figures), is the row's ``metric_error``."""
-    from .sweep import FIGURES, TRAILING
+    from .figures import FIGURES, TRAILING
 
     try:
         value = metric(done, point) if takes_point(metric) else metric(done)
