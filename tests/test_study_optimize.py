@@ -78,11 +78,12 @@ def test_a_strain_limit_picks_the_narrowest_hinge_that_keeps_to_it():
     assert (narrower["largest_strain"] > 0.6).all()
 
 
-def test_the_same_seed_gives_the_same_trials_and_a_rerun_replays_them(tmp_path):
+def test_the_same_seed_gives_the_same_trials_and_a_rerun_replays_them(tmp_path,
+                                                                      monkeypatch):
     def run(seed, trials=6, **kw):
         return study.optimize("miura", {"hinge-width": WIDTHS, "gamma": (45.0, 75.0)},
                               "largest_strain", fixed={**MIURA, "n": 2, "m": 2},
-                              trials=trials, seed=seed, workers=0, **kw)
+                              trials=trials, seed=seed, **{"workers": 0, **kw})
 
     first, again = run(0, cache=None), run(0, cache=None)
     columns = ["hinge-width", "gamma", "objective"]
@@ -90,10 +91,19 @@ def test_the_same_seed_gives_the_same_trials_and_a_rerun_replays_them(tmp_path):
     assert not first.history["hinge-width"].equals(run(1, cache=None).history["hinge-width"])
 
     folded = run(0, cache=tmp_path)
-    replayed = run(0, trials=8, cache=tmp_path)
     assert not folded.history["cached"].any()
-    assert list(replayed.history["cached"]) == [True] * 6 + [False] * 2
-    assert replayed.history[columns].head(6).equals(folded.history[columns])
+
+    def no_cluster(*args, **kwargs):
+        raise AssertionError("a replay started a cluster")
+
+    with monkeypatch.context() as patched:  # all cached: no cluster is started
+        patched.setattr("foldcore.study.execute.session", no_cluster)
+        replayed = run(0, cache=tmp_path, workers=2, batch=1)
+    assert replayed.history["cached"].all()
+    assert replayed.history[columns].equals(folded.history[columns])
+    longer = run(0, trials=8, cache=tmp_path)
+    assert list(longer.history["cached"]) == [True] * 6 + [False] * 2
+    assert longer.history[columns].head(6).equals(folded.history[columns])
 
 
 def test_a_failed_fold_is_a_row_with_its_error_and_the_study_goes_on():

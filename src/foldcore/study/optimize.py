@@ -42,7 +42,8 @@ is feasible.
 Finished trials go to the study cache (:mod:`foldcore.study.cache`): a rerun
 of the same optimisation (same seed, trials, batch and space) asks the same
 points and takes each from the cache, folding nothing again but the failed
-ones; a rerun with more trials folds only the new ones.
+ones (and starting no cluster when nothing is left to fold); a rerun with more
+trials folds only the new ones.
 """
 from __future__ import annotations
 
@@ -284,35 +285,41 @@ class _Search:
 
     def run(self, sampler, trials: int, batch, progress, where: dict) -> None:
         """Ask, fold and tell batches until ``trials`` rows (``where``: client,
-        scheduler, workers of :func:`foldcore.study.execute.session`)."""
+        scheduler, workers of :func:`foldcore.study.execute.session`). The cluster
+        is started (or reached) at the first trial the cache lacks: a replay needs none."""
+        from contextlib import ExitStack
+
         from .execute import progress_bar, session
 
         bar = progress_bar(trials, progress, unit="trial")
-        try:
-            with _quiet_optuna():
-                import optuna
+        opened: list = []
+        with ExitStack() as stack, _quiet_optuna():
+            stack.callback(bar.close)
 
-                study = optuna.create_study(
-                    direction="minimize" if self.goal.minimize else "maximize",
-                    sampler=sampler)
-                with session(self.source, **where) as folding:
-                    size = batch or max(1, folding.workers)
-                    while len(self.rows) < trials:
-                        bar.update(self.batch(study, folding,
-                                              min(size, trials - len(self.rows))))
-        finally:
-            bar.close()
+            def folding():
+                if not opened:
+                    opened.append(stack.enter_context(session(self.source, **where)))
+                return opened[0]
 
-    def batch(self, study, where, size: int) -> int:
-        """Ask ``size`` trials, fold them on ``where`` (a Session), tell them in order."""
+            import optuna
+
+            study = optuna.create_study(
+                direction="minimize" if self.goal.minimize else "maximize", sampler=sampler)
+            size = batch or _workers(where, folding)
+            while len(self.rows) < trials:
+                bar.update(self.batch(study, folding, min(size, trials - len(self.rows))))
+
+    def batch(self, study, folding, size: int) -> int:
+        """Ask ``size`` trials, fold them (``folding()``: the Session), tell them in
+        order."""
         asked = [study.ask(self.distributions) for _ in range(size)]
         points = [{**{d.name: t.params[d.name] for d in self.dims}, **self.fixed}
                   for t in asked]
-        for trial, row in zip(asked, self.fold(where, points)):
+        for trial, row in zip(asked, self.fold(folding, points)):
             self.tell(study, trial, row)
         return size
 
-    def fold(self, where, points: list[dict]) -> list[dict]:
+    def fold(self, folding, points: list[dict]) -> list[dict]:
         """Rows of ``points``: from the cache, or folded (each from the flat sheet)."""
         keys = [point_key(self.source.key(), p, [], self.metric) for p in points]
         rows: list = [None] * len(points)
@@ -332,8 +339,8 @@ class _Search:
                 rows[i] = {**row, "cached": False}
 
         if missing:
-            where.run(points, missing, metric=self.metric, continuation=False,
-                      on_rows=arrived)
+            folding().run(points, missing, metric=self.metric, continuation=False,
+                          on_rows=arrived)
         return rows
 
     def tell(self, study, trial, row: dict) -> None:
@@ -476,6 +483,18 @@ def _integral(source, name: str) -> bool:
     annotation = getattr(param.annotation, "__name__", param.annotation)
     return (isinstance(default, int) and not isinstance(default, bool)) \
         or str(annotation).startswith("int")
+
+
+def _workers(where: dict, folding) -> int:
+    """The default batch: the workers of the user's client, of the embedded cluster
+    to be (without starting it), or of the scheduler's (reached); 1 in this process."""
+    from .execute import default_workers
+
+    if where["client"] is not None:
+        return max(1, len(where["client"].scheduler_info(n_workers=-1)["workers"]))
+    if where["scheduler"] is not None:
+        return max(1, folding().workers)
+    return 1 if where["workers"] == 0 else where["workers"] or default_workers()
 
 
 def _check_counts(trials, batch) -> None:
