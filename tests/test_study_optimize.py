@@ -61,6 +61,16 @@ def test_the_optimum_is_the_fine_sweeps_minimum_within_one_grid_step(fine_sweep,
                                                                   tolerance)
 
 
+def test_a_trials_row_is_the_sweep_row_of_its_point():
+    found = study.optimize("miura", {"hinge-width": WIDTHS}, "largest_strain", fixed=MIURA,
+                           trials=2, workers=0, cache=None)
+    swept = study.sweep("miura", points=[found.best], workers=0, cache=None, progress=False)
+    timing = {"wall_s", "run_s", "setup_s"}
+    same = [c for c in study.FIGURES if c not in timing] + list(found.best)
+    row = found.history.loc[found.history["trial"] == found.trial, same]
+    assert row.reset_index(drop=True).equals(swept[same])
+
+
 def test_a_strain_limit_picks_the_narrowest_hinge_that_keeps_to_it():
     """Minimising miss_max_deg under largest_strain ≤ 0.6: wider hinges strain less
     but miss more, so the best is just past where the strain falls to 0.6."""
