@@ -142,7 +142,7 @@ def test_on_a_local_cluster_the_trials_run_on_its_workers():
     from distributed import Client, LocalCluster
 
     with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                      dashboard_address=None) as cluster, Client(cluster) as client:
+                      dashboard_address=":0") as cluster, Client(cluster) as client:
         addresses = set(client.scheduler_info(n_workers=-1)["workers"])
         found = study.optimize("miura", {"hinge-width": WIDTHS}, "largest_strain",
                                fixed=MIURA, trials=6, client=client, cache=None)
