@@ -10,13 +10,17 @@ generator's pattern with its parameters (:mod:`.source`). Points run on Dask
 distributed (:mod:`.execute`: an embedded LocalCluster by default, or an existing
 cluster); finished points are cached on disk (:mod:`.cache`), so a rerun folds
 only what is missing. :func:`sweep` returns the table (pandas), :func:`write_table`
-writes it as CSV or Parquet. Needs the ``study`` extra (dask, distributed, pandas).
+writes it as CSV or Parquet. :func:`optimize` searches ranges of the same names
+for the point whose fold minimises (or maximises) a column of its row, with
+Optuna (:mod:`.optimize`). Needs the ``study`` extra (dask, distributed, pandas,
+optuna).
 """
 from __future__ import annotations
 
 from .points import OPTIONS, StudyError, grid, parse_set, read_points
+from .optimize import Optimum, optimize
 from .sweep import FIGURES, sweep
 from .table import write_table
 
-__all__ = ["OPTIONS", "FIGURES", "StudyError", "grid", "parse_set", "read_points", "sweep",
-           "write_table"]
+__all__ = ["OPTIONS", "FIGURES", "Optimum", "StudyError", "grid", "optimize", "parse_set",
+           "read_points", "sweep", "write_table"]

@@ -1,4 +1,5 @@
-"""``foldcore sweep``: a design study from the command line (:func:`foldcore.study.sweep`).
+"""``foldcore sweep`` and ``foldcore optimize``: design studies from the command line
+(:func:`foldcore.study.sweep`, :func:`foldcore.study.optimize`).
 
 ``foldcore sweep PATTERN --set NAME=V1,V2,… [--set …] -o results.csv|.parquet``
 folds every combination of the values (or the points of ``--points CSV``) on
@@ -7,8 +8,12 @@ running scheduler (``--scheduler tcp://HOST:PORT``). PATTERN is a file or a
 built-in generator's name (``miura``: ``--set n=4 --set gamma=50,60``).
 ``--plots DIR`` and ``--report OUT.html`` add what a designer reads
 (:mod:`foldcore.study.report`).
-Exit codes as ``simulate``: 2 with one line for bad input (before any fold),
-130 on Ctrl-C (the finished points are cached: the same command resumes).
+``foldcore optimize PATTERN --vary NAME=LOW:HIGH [--set NAME=V] --minimize COLUMN
+-o history.csv`` searches the range for the point whose fold minimises (or
+``--maximize``) a column of its row, one fold per trial, and prints the best
+point in one line. Exit codes as ``simulate``: 2 with one line for bad input
+(before any fold), 130 on Ctrl-C (the finished points are cached: the same
+command resumes).
 Importing this module imports neither Dask nor pandas.
 """
 from __future__ import annotations
@@ -23,7 +28,7 @@ EXIT_SIGINT = 130
 
 
 def add_to(sub) -> None:
-    """Add ``sweep`` to the command line's subparsers."""
+    """Add ``sweep`` and ``optimize`` to the command line's subparsers."""
     from .source import GENERATORS
 
     sweep = sub.add_parser("sweep", help="fold a pattern over a grid of option values "
@@ -55,6 +60,57 @@ def add_to(sub) -> None:
                        help="one self-contained HTML page: summary, plots, table; with "
                             "--keep, a picture of each folded solid linking to its view "
                             "page (in OUT_files/)")
+    add_optimize(sub)
+
+
+def add_optimize(sub) -> None:
+    """Add ``optimize`` to the command line's subparsers."""
+    from .optimize import SAMPLERS
+    from .source import GENERATORS
+
+    opt = sub.add_parser("optimize", help="search option values for the fold that minimises "
+                                          "or maximises a figure (a design study, on Dask)")
+    opt.add_argument("pattern", help="crease pattern file, or a generator: "
+                                     + ", ".join(GENERATORS))
+    opt.add_argument("--vary", action="append", required=True,
+                     metavar="NAME=LOW:HIGH[:log|:STEP]",
+                     help="a range to search (an option, e.g. hinge-width=0.2:2 mm, or a "
+                          "generator's parameter; integers for an integer name), or "
+                          "NAME=V1,V2,… to choose among")
+    opt.add_argument("--set", action="append", default=[], metavar="NAME=V",
+                     help="a fixed value (an option or a generator's parameter)")
+    goal = opt.add_mutually_exclusive_group(required=True)
+    goal.add_argument("--minimize", metavar="COLUMN",
+                      help="the row's column to minimise (largest_strain, miss_max_deg, … "
+                           "or a --metric column)")
+    goal.add_argument("--maximize", metavar="COLUMN", help="the row's column to maximise")
+    opt.add_argument("--at-most", action="append", default=[], metavar="COLUMN=MOST",
+                     help="a constraint: a feasible trial's COLUMN is at most MOST (and it "
+                          "converged, always)")
+    opt.add_argument("--trials", type=_count, default=40, metavar="N",
+                     help="folds in all (default 40)")
+    opt.add_argument("--seed", type=int, default=0, help="the sampler's seed (default 0)")
+    opt.add_argument("--sampler", choices=SAMPLERS, default="tpe",
+                     help="tpe (default), random, or qmc (scrambled Sobol)")
+    opt.add_argument("--batch", type=_count, metavar="N",
+                     help="trials folded together (default: the cluster's workers)")
+    opt.add_argument("-o", "--output", required=True,
+                     help="the history, a row per trial: .csv, or .parquet (pyarrow)")
+    opt.add_argument("--hinges", help="hinge file of an OBJ/STL pattern")
+    opt.add_argument("--metric", metavar="FILE.py:FUNCTION",
+                     help="your metric of each fold: FUNCTION(fold) → number or dict "
+                          "(columns), from a Python file or module:function")
+    add_execution(opt)
+
+
+def _count(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        value = 0
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"expected a positive integer, got {text!r}")
+    return value
 
 
 def add_execution(parser) -> None:
@@ -132,6 +188,49 @@ def say_failures(frame) -> None:
               f"error; row {failed.index[0]}: {failed['error'].iloc[0]})", file=sys.stderr)
 
 
+def run_optimize(args) -> int:
+    """Run ``foldcore optimize``; raises FoldcoreError on bad input."""
+    from ..destinations import check_destinations
+    from .optimize import optimize, parse_bound, parse_fixed, parse_vary
+    from .points import StudyError
+    from .table import TABLE_SUFFIXES, write_table
+
+    check_destinations({"-o": args.output}, inputs=(args.pattern, args.hinges),
+                       suffixes={"-o": TABLE_SUFFIXES})
+    space, fixed = dict(map(parse_vary, args.vary)), dict(map(parse_fixed, args.set))
+    limits = dict(map(parse_bound, args.at_most))
+    if len(space) < len(args.vary) or len(fixed) < len(args.set):
+        raise StudyError("a name is given to --vary or --set twice")
+    start = time.perf_counter()
+    try:
+        found = optimize(args.pattern, space, args.minimize or args.maximize, fixed=fixed,
+                         trials=args.trials, minimize=args.minimize is not None,
+                         sampler=args.sampler, seed=args.seed, constraints=limits,
+                         metric=load_metric(args.metric) if args.metric else None,
+                         hinges=args.hinges, batch=args.batch, **execution(args))
+    except KeyboardInterrupt:
+        print("foldcore: interrupted (SIGINT); the trials that finished are cached: the "
+              "same command replays them and folds only the others", file=sys.stderr)
+        return EXIT_SIGINT
+    write_table(found.history, args.output)
+    if not args.quiet:
+        print(f"foldcore: optimize: {found.line()}; {_tally(found.history)} in "
+              f"{time.perf_counter() - start:.3g} s → {args.output}", file=sys.stderr)
+    say_failures(found.history)
+    return 0
+
+
+def _tally(frame) -> str:
+    """``N trials (F folded on W workers, C from the cache, X failed, I infeasible)``."""
+    failed = int((frame["objective"].isna()).sum())
+    cached = frame["cached"].fillna(False).astype(bool)
+    workers = frame.loc[~cached, "worker"].nunique()
+    infeasible = int((~frame["feasible"].astype(bool)).sum()) - failed
+    return (f"{len(frame)} trials ({int((~cached).sum())} folded on {workers} "
+            f"worker{'s' if workers != 1 else ''}, {int(cached.sum())} from the cache, "
+            f"{failed} failed, {infeasible} infeasible)")
+
+
 def execution(args) -> dict:
     """The study's execution options from the flags."""
     return {"scheduler": args.scheduler, "workers": args.workers,
@@ -180,4 +279,4 @@ def load_metric(spec: str):
 
 
 #: Command name → function, for the command line's dispatch.
-COMMANDS = {"sweep": run_sweep}
+COMMANDS = {"sweep": run_sweep, "optimize": run_optimize}

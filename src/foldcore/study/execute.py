@@ -11,6 +11,8 @@ Each continuation path is one task; rows are cached as they arrive, so a
 study stopped by Ctrl-C or a lost worker resumes where it was. A task on a
 worker that dies is run again elsewhere by the scheduler (up to its
 ``allowed-failures``); a point that fails is a row with its error.
+:func:`session` keeps one client, shipped pattern and warm workers for many
+batches of paths (an optimisation's, :mod:`foldcore.study.optimize`).
 """
 from __future__ import annotations
 
@@ -42,42 +44,87 @@ def run_paths(source, points: list[dict], plan: list[list[int]], *, metric=None,
     progress : bool or None
         A tqdm bar of points on stderr (None: only on a terminal).
     """
-    bar = _bar(sum(map(len, plan)), progress)
+    bar = progress_bar(sum(map(len, plan)), progress)
     try:
-        if workers == 0 and client is None and scheduler is None:
-            _warm_worker()  # (else the first point's times would include loading kernels)
-            for ids in plan:
-                rows = run_path(source, [points[i] for i in ids], metric=metric, keep=keep,
-                                continuation=continuation)
-                on_rows(ids, rows)
-                bar.update(len(ids))
-            return
-        with _client(client, scheduler, workers) as dask:
-            _on_cluster(dask, source, points, plan, metric, keep, continuation, on_rows, bar)
+        with session(source, client=client, scheduler=scheduler, workers=workers) as where:
+            where.run(points, plan, metric=metric, keep=keep, continuation=continuation,
+                      on_rows=on_rows, bar=bar)
     finally:
         bar.close()
 
 
-def _on_cluster(dask, source, points, plan, metric, keep, continuation, on_rows, bar):
-    from distributed import as_completed
+@contextmanager
+def session(source, *, client=None, scheduler=None, workers=None):
+    """A :class:`Session` folding ``source``'s points for as many batches as its
+    caller runs (:mod:`foldcore.study.optimize`): one client, the pattern shipped
+    and the workers warmed once. Arguments as :func:`run_paths`'s."""
+    if workers == 0 and client is None and scheduler is None:
+        yield Session(source)
+        return
+    with _client(client, scheduler, workers) as dask:
+        yield Session(source, dask)
 
-    shipped = dask.scatter(source, broadcast=True, hash=False)
-    metric = None if metric is None else ByValue(metric)
-    dask.run(_warm_worker)
-    log.info("study: %d paths on %d workers", len(plan),
-             len(dask.scheduler_info(n_workers=-1)["workers"]))
-    futures = {}
-    for ids in plan:
-        future = dask.submit(run_path, shipped, [points[i] for i in ids], metric=metric,
-                             keep=keep, continuation=continuation, pure=False)
-        futures[future] = ids
-    try:
-        for future in as_completed(futures):
-            ids = futures[future]
-            on_rows(ids, _rows_or_error(future, [points[i] for i in ids]))
-            bar.update(len(ids))
-    finally:
-        dask.cancel(list(futures))
+
+class Session:
+    """Where a study's paths fold: a Dask client with the source scattered to every
+    worker and each worker's kernels loaded, or this process (``dask`` None)."""
+
+    def __init__(self, source, dask=None):
+        self.source, self.dask = source, dask
+        self.shipped = source
+        if dask is None:
+            _warm_worker()  # (else the first point's times would include loading kernels)
+        else:
+            self.shipped = dask.scatter(source, broadcast=True, hash=False)
+            dask.run(_warm_worker)
+
+    @property
+    def workers(self) -> int:
+        """Workers the cluster has now (1 in this process)."""
+        if self.dask is None:
+            return 1
+        return len(self.dask.scheduler_info(n_workers=-1)["workers"])
+
+    def run(self, points: list[dict], plan: list[list[int]], *, metric=None,
+            keep: bool = False, continuation: bool = True, on_rows=None, bar=None) -> None:
+        """Fold each path of ``plan`` and hand its rows to ``on_rows(indices, rows)``
+        as they arrive; a path that raises is a row per point with its error."""
+        if self.dask is None:
+            for ids in plan:
+                path = [points[i] for i in ids]
+                try:
+                    rows = run_path(self.source, path, metric=metric, keep=keep,
+                                    continuation=continuation)
+                except Exception as exc:  # a failing path is rows, never the end
+                    rows = _error_rows(path, exc, "")
+                on_rows(ids, rows)
+                if bar is not None:
+                    bar.update(len(ids))
+            return
+        self._on_cluster(points, plan, None if metric is None else ByValue(metric), keep,
+                         continuation, on_rows, bar)
+
+    def _on_cluster(self, points, plan, metric, keep, continuation, on_rows, bar):
+        from distributed import as_completed
+
+        log.info("study: %d paths on %d workers", len(plan), self.workers)
+        # Dask's memory manager drops the broadcast's extra copies while no task needs
+        # them, and then every task goes where the one copy is: copy it back first.
+        self.dask.replicate([self.shipped])
+        futures = {}
+        for ids in plan:
+            future = self.dask.submit(run_path, self.shipped, [points[i] for i in ids],
+                                      metric=metric, keep=keep, continuation=continuation,
+                                      pure=False)
+            futures[future] = ids
+        try:
+            for future in as_completed(futures):
+                ids = futures[future]
+                on_rows(ids, _rows_or_error(future, [points[i] for i in ids]))
+                if bar is not None:
+                    bar.update(len(ids))
+        finally:
+            self.dask.cancel(list(futures))
 
 
 def _rows_or_error(future, points: list[dict]) -> list[dict]:
@@ -86,9 +133,14 @@ def _rows_or_error(future, points: list[dict]) -> list[dict]:
     try:
         return future.result()
     except Exception as exc:
-        from .task import error_text
+        return _error_rows(points, exc, "lost: ")
 
-        return [{**p, "error": f"lost: {error_text(exc)}"} for p in points]
+
+def _error_rows(points: list[dict], exc: BaseException, prefix: str) -> list[dict]:
+    """A row per point, each with the error that ended its path."""
+    from .task import error_text
+
+    return [{**p, "error": f"{prefix}{error_text(exc)}"} for p in points]
 
 
 class ByValue:
@@ -181,9 +233,10 @@ def default_workers() -> int:
         return os.cpu_count() or 1
 
 
-def _bar(total: int, progress):
+def progress_bar(total: int, progress, unit: str = "point"):
+    """A tqdm bar on stderr (``progress`` None: only on a terminal)."""
     from tqdm import tqdm
 
     shown = sys.stderr.isatty() if progress is None else bool(progress)
-    return tqdm(total=total, unit="point", file=sys.stderr, disable=not shown,
+    return tqdm(total=total, unit=unit, file=sys.stderr, disable=not shown,
                 dynamic_ncols=True, leave=False)
