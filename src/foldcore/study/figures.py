@@ -17,6 +17,8 @@ FIGURES = ("converged", "reason", "iterations", "wall_s", "run_s", "setup_s",
            "stack_height_mm")
 #: The table's columns after the metric's.
 TRAILING = ("start", "worker", "cached", "result_fold", "warnings", "error")
+#: Columns a study adds beside those (a metric may not use their names either).
+RESERVED = ("metric", "metric_error", "trial", "objective", "feasible")
 
 
 def figures(result, pattern, mesh) -> dict:

@@ -157,5 +157,9 @@ _FOLDER: list = []
 def _worker_folder() -> Path:
     """This process's folder for the patterns it folds (removed when it exits)."""
     if not _FOLDER:
-        _FOLDER.append(tempfile.TemporaryDirectory(prefix="foldcore-study-"))
-    return Path(_FOLDER[0].name)
+        import atexit
+        import shutil
+
+        _FOLDER.append(Path(tempfile.mkdtemp(prefix="foldcore-study-")))
+        atexit.register(shutil.rmtree, _FOLDER[0], ignore_errors=True)
+    return _FOLDER[0]

@@ -18,10 +18,10 @@ def write_table(frame, path) -> None:
     if suffix not in TABLE_SUFFIXES:
         raise StudyError(f"{name}: a table is written as {' or '.join(TABLE_SUFFIXES)}")
     if suffix == ".parquet":
-        try:
-            import pyarrow  # noqa: F401
-        except ImportError:
-            raise StudyError(f"{name}: Parquet needs pyarrow (pip install pyarrow)") from None
+        import importlib.util
+
+        if importlib.util.find_spec("pyarrow") is None:
+            raise StudyError(f"{name}: Parquet needs pyarrow (pip install pyarrow)")
         with atomic_write(name, binary=True) as fh:
             frame.to_parquet(fh, index=False)
         return

@@ -118,7 +118,7 @@ def _generator_parameters(source, point: dict) -> dict:
 def _metric_columns(metric, done, point: dict, taken=()) -> dict:
     """The metric's columns; its failure, or a column named as one the row has
     (``taken``: the point's names, the figures), is the row's ``metric_error``."""
-    from .figures import FIGURES, TRAILING
+    from .figures import FIGURES, RESERVED, TRAILING
 
     try:
         value = metric(done, point) if takes_point(metric) else metric(done)
@@ -127,10 +127,11 @@ def _metric_columns(metric, done, point: dict, taken=()) -> dict:
     if not isinstance(value, dict):
         return {"metric": float(value) if value is not None else math.nan}
     columns = {str(k): v for k, v in value.items()}
-    clash = sorted(set(columns) & ({*taken, *FIGURES, *TRAILING, "metric_error"}))
+    clash = sorted(set(columns) & ({*taken, *FIGURES, *TRAILING, *RESERVED}))
     if clash:
         return {"metric_error": f"the metric's column {clash[0]!r} is a column of the row "
-                                "already (a point's name or a figure): rename it"}
+                                "already (a point's name, a figure or the study's own): "
+                                "rename it"}
     return columns
 
 
