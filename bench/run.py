@@ -18,7 +18,7 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 BENCHMARKS = ("startup", "scaling", "time_to_solution", "convergence", "accuracy",
               "real_patterns", "paths", "load", "reading", "origami_simulator", "flat_vertex",
-              "contact")
+              "contact", "study")
 
 
 def main() -> int:

@@ -203,9 +203,12 @@ def _client(client, scheduler, workers):
     n = workers or default_workers()
     one_thread = {name: "1" for name in ("NUMBA_NUM_THREADS", "OMP_NUM_THREADS",
                                          "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")}
+    # (its workers' logs at CRITICAL: a heartbeat racing the scheduler's close logs an
+    # error with a traceback; a point's own failure is its row's error)
     with _reached("the embedded LocalCluster", lambda: LocalCluster(
             n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0",
-            silence_logs=logging.ERROR, env=one_thread)) as cluster, Client(cluster) as dask:
+            silence_logs=logging.CRITICAL, env=one_thread)) as cluster, \
+            Client(cluster) as dask:
         yield dask
 
 
