@@ -591,6 +591,29 @@ def test_a_tolerance_below_the_resolution_is_stalled_in_every_unit(solver):
         assert 1e-12 < result.residual < 1e-10
 
 
+def test_a_budget_that_ends_while_the_steps_still_move_is_not_converged():
+    """A binding vertex of degree 5 (fold 134 of ``tools/verdict_check.py``'s set)
+    under hybrid: after the rigid phase, newton crawls in steps of about twice the
+    limit, each lowering E, toward an equilibrium hundreds of limits away; the
+    certificate's step at the budget's end stayed within the limit (its
+    linearisation holds the passive strips' bends as stiff as actuated ones) and
+    the run ended ``converged`` where a newton re-run turns the creases by more
+    than two tolerance-states apart. A state the steps still move beyond the
+    limit is not converged: ``budget``, the last step (beyond tolerance × size)
+    its residual."""
+    problem = problem_set(135, 7)[134]
+    assert problem.name.startswith("vertex_n n=5 driven [14, 56]")
+    mesh = thicken(problem.pattern, problem.thickness)
+    sim = Simulation(mesh, problem.pattern)
+    result = sim.run(tolerance=1e-8, max_iterations=2000)
+    assert result.reason == "budget" and result.residual > 1e-8
+    check = Simulation(mesh, problem.pattern, solver="newton", branch_floor_deg=0.0)
+    check.set_positions(result.positions)
+    again = check.run(tolerance=1e-8, max_iterations=300)
+    allowed = angle_bound_deg(1e-8, sim.length_scale, problem.thickness)
+    assert np.nanmax(np.abs(again.fold_angles_deg - result.fold_angles_deg)) > allowed
+
+
 def test_a_budget_that_ends_at_a_certified_state_is_converged():
     """L-BFGS folds this hinge in 47 iterations, the last ten the probe's hold; its
     state is certified from iteration 36 on (measured): a budget of 40 ends there
