@@ -239,7 +239,8 @@ def plot(data: dict, path) -> None:
 
 
 def table(data: dict) -> str:
-    """Error (°) / wall time (s) per case and column."""
+    """Error (°) / wall time (s) per case and column; ✗: the run did not converge
+    (stalled, or at its budget): its error is that of its last iterate."""
     columns = [("axis", "hybrid", "equal"), ("axis", "rigid", "equal"),
                ("axis", "lbfgs", "equal"), ("arc", "hybrid", "equal"),
                ("arc", "hybrid", "angle"), ("eq8", "hybrid", "equal")]
@@ -255,8 +256,8 @@ def table(data: dict) -> str:
         for model, strategy, actuation in columns:
             rows = [r for r in data[sweep] if r["model"] == model and r["strategy"] == strategy
                     and r["actuation"] == actuation and all(r[k] == v for k, v in where.items())]
-            cells.append(f"{rows[0]['error_deg']:.2g}° / {rows[0]['seconds']:.2g} s" if rows
-                         else "—")
+            cells.append(f"{rows[0]['error_deg']:.2g}°{'' if rows[0]['converged'] else ' ✗'} / "
+                         f"{rows[0]['seconds']:.2g} s" if rows else "—")
         if any(c != "—" for c in cells[1:]):
             body.append(cells)
     return _meta.markdown_table(header, body)
