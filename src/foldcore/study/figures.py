@@ -12,7 +12,7 @@ import numpy as np
 #: The figures' columns, in the table's order, after the point's own names.
 FIGURES = ("converged", "reason", "iterations", "wall_s", "run_s", "setup_s",
            "miss_max_deg", "miss_median_deg", "driven", "binding", "residual",
-           "largest_strain", "fractured", "largest_overlap_mm", "contact_pairs",
+           "largest_strain", "fractured", "contact_pairs",
            "smallest_gap_mm", "touching_panels", "bbox_x_mm", "bbox_y_mm", "bbox_z_mm",
            "stack_height_mm")
 #: The table's columns after the metric's.
@@ -33,15 +33,13 @@ def figures(result, pattern, mesh) -> dict:
         ``miss_median_deg`` (driven creases' |achieved − target|, as the
         report's actuation), ``driven``, ``binding``; ``largest_strain``
         (sub-strips' largest |surface strain|, NaN without hinges),
-        ``fractured`` (hinges past their strain limits), ``largest_overlap_mm``
-        (panels' largest interpenetration at a crease); ``contact_pairs``,
+        ``fractured`` (hinges past their strain limits); ``contact_pairs``,
         ``smallest_gap_mm``, ``touching_panels`` (NaN with contact off); and the
         folded solid's ``bbox_x_mm``, ``bbox_y_mm``, ``bbox_z_mm`` and
         ``stack_height_mm`` (its least extent along its principal axes: the
         stack's height when folded flat).
     """
     from ..outputs import actuation_entries
-    from ..measure import crease_overlaps
 
     act = actuation_entries(result, pattern)
     timings = result.timings_s
@@ -53,10 +51,7 @@ def figures(result, pattern, mesh) -> dict:
            "driven": len(act["creases"]), "binding": act["binding"],
            "largest_strain": float(np.abs(strains).max()) if strains is not None
            and len(strains) else math.nan,
-           "fractured": len(result.failures),
-           "largest_overlap_mm": float(np.nanmax(crease_overlaps(pattern, mesh,
-                                                                 result.positions),
-                                                 initial=0.0))}
+           "fractured": len(result.failures)}
     row.update(_contact(result.contact))
     row.update(extents(result.positions))
     return row
