@@ -24,6 +24,12 @@ from contextlib import contextmanager
 from .task import run_path
 
 log = logging.getLogger("foldcore.study")
+#: Dask's setting that has a nanny start its worker with ``MALLOC_TRIM_THRESHOLD_``
+#: (65536): glibc then returns freed memory at once and maps every large array
+#: afresh, which slows a fold down (part of the per-point overhead that
+#: ``bench/study.py`` measures); the embedded cluster unsets it (None), a cluster
+#: started by hand can by configuration (docs/guide/studies.md).
+TRIM = "distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_"
 
 
 def run_paths(source, points: list[dict], plan: list[list[int]], *, metric=None,
@@ -198,6 +204,7 @@ def _client(client, scheduler, workers):
         with _reached(scheduler, lambda: Client(scheduler, timeout="30s")) as dask:
             yield dask
         return
+    from dask import config as dask_config
     from distributed import LocalCluster
 
     n = workers or default_workers()
@@ -205,10 +212,11 @@ def _client(client, scheduler, workers):
                                          "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")}
     # (its workers' logs at CRITICAL: a heartbeat racing the scheduler's close logs an
     # error with a traceback; a point's own failure is its row's error)
-    with _reached("the embedded LocalCluster", lambda: LocalCluster(
-            n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0",
-            silence_logs=logging.CRITICAL, env=one_thread)) as cluster, \
-            Client(cluster) as dask:
+    start = lambda: LocalCluster(  # noqa: E731
+        n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0",
+        silence_logs=logging.CRITICAL, env=one_thread)
+    with dask_config.set({TRIM: None}), _reached("the embedded LocalCluster", start) \
+            as cluster, Client(cluster) as dask:
         yield dask
 
 
