@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import foldcore
-from foldcore import cli, patterns
+from foldcore import cli, interrupts, patterns
 from foldcore.errors import RunWarning
 from foldcore.job import Interrupted
 from foldcore.options import OptionError
@@ -113,7 +113,7 @@ def test_ctrl_c_writes_the_last_iterate_marked_partial(hinge_file, tmp_path, cap
     out, report = tmp_path / "o.fold", tmp_path / "r.json"
     code = cli.main(["simulate", str(hinge_file), "--subdivisions", "4", "--solver", "paper",
                      "-o", str(out), "--report", str(report)])
-    assert code == cli.EXIT_SIGINT
+    assert code == interrupts.EXIT_SIGINT
     (line,) = capsys.readouterr().err.splitlines()
     assert "interrupted (SIGINT) after 29 iterations" in line and str(out) in line
     fold, rep = json.loads(out.read_text()), json.loads(report.read_text())
@@ -149,7 +149,7 @@ def test_ctrl_c_while_the_finished_result_is_written_completes_it(hinge_file, tm
     monkeypatch.setattr(outputs, "write_result", interrupted_write)
     out, report = tmp_path / "o.fold", tmp_path / "r.json"
     code = cli.main(["simulate", str(hinge_file), "-o", str(out), "--report", str(report)])
-    assert code == cli.EXIT_SIGINT
+    assert code == interrupts.EXIT_SIGINT
     (line,) = capsys.readouterr().err.splitlines()
     assert "while the finished result was written" in line and str(out) in line
     fold, rep = json.loads(out.read_text()), json.loads(report.read_text())
