@@ -693,6 +693,46 @@ def test_fuzz_svg_mutated_real_files(fuzz_dir, name, cuts):
     outcome(lambda: fio.read(path), path)
 
 
+_CP_SQUARE = ["1 0 0 100 0", "1 100 0 100 100", "1 100 100 0 100", "1 0 100 0 0"]
+_CP_NUMBERS = st.one_of(st.integers(-10, 110).map(str), st.floats(allow_nan=True,
+                        allow_infinity=True).map(repr), st.sampled_from(
+                        ["1e309", "-0", "1e-320", "0x10", "", "nan", "1_0"]))
+
+
+@st.composite
+def cp_texts(draw) -> bytes:
+    """The square sheet plus generated lines: well-formed ones on a small grid (so they
+    cross, overlap and meet), wrong field counts, garbage and odd numbers."""
+    lines = list(_CP_SQUARE)
+    grid = st.integers(0, 4).map(lambda i: str(25 * i))
+    clean = draw(st.booleans())  # only well-formed lines: patterns to read, not refusals
+    for _ in range(draw(st.integers(0, 12))):
+        if clean or draw(st.integers(0, 3)):  # well formed, on a 25-unit grid
+            kind = draw(st.sampled_from(["2", "3", "4", "1"]))
+            lines.append(" ".join([kind] + [draw(grid) for _ in range(4)]))
+            continue
+        kind = draw(st.sampled_from(["0", "1", "2", "3", "4", "5", "-1", "x", "2.0"]))
+        count = draw(st.sampled_from([4, 4, 4, 4, 3, 5, 0]))
+        lines.append(" ".join([kind] + [draw(_CP_NUMBERS) for _ in range(count)]))
+    if not clean and draw(st.integers(0, 6)) == 0:
+        lines.append(draw(NASTY_TEXT))
+    text = "\n".join(draw(st.permutations(lines))).encode("utf-8", "surrogatepass")
+    if not clean and draw(st.integers(0, 6)) == 0:
+        text = text[:draw(st.integers(0, len(text)))] + draw(st.binary(max_size=8))
+    return text
+
+
+@FUZZ
+@given(blob=cp_texts())
+def test_fuzz_cp(fuzz_dir, blob):
+    """Generated .cp files through :func:`foldcore.io.read`: a valid pattern or one
+    line naming the file."""
+    path = os.path.join(fuzz_dir, "p.cp")
+    with open(path, "wb") as fh:
+        fh.write(blob)
+    outcome(lambda: fio.read(path), path)
+
+
 # -------------------------------------------------------- plain regressions
 @pytest.mark.parametrize("path", ["bad\0name.fold", "bad\0name.obj", "bad\0name.stl"])
 def test_nul_in_path_refused(path):
@@ -708,11 +748,13 @@ def test_directory_refused(tmp_path, name):
         fio.read(tmp_path / name, hinges=tmp_path if name != "d.fold" else None)
 
 
-@pytest.mark.parametrize("suffix", [".fold", ".obj", ".stl", ".hinges"])
+@pytest.mark.parametrize("suffix", [".fold", ".obj", ".stl", ".hinges", ".cp"])
 def test_size_limit_every_reader(tmp_path, monkeypatch, suffix):
-    """FOLD, OBJ, STL and hinge files are all refused above MAX_FILE_BYTES, unopened."""
+    """FOLD, OBJ, STL, .cp and hinge files are all refused above MAX_FILE_BYTES, unopened."""
     p = BASES[2]
     fio.write_fold(tmp_path / "p.fold", p)
+    (tmp_path / "p.cp").write_text("".join(f"2 {a[0]} {a[1]} {b[0]} {b[1]}\n"
+                                           for a, b in p.vertices[p.edges]))
     fio.write_obj(tmp_path / "p.obj", p)
     fio.write_hinges(tmp_path / "p.hinges", p)
     (tmp_path / "p.stl").write_text(_ascii_stl([[(x, y, 0.0) for x, y in t]
@@ -730,7 +772,8 @@ def test_size_limit_every_reader(tmp_path, monkeypatch, suffix):
     monkeypatch.setattr("builtins.open", spy)
     mesh = tmp_path / ("small.obj" if suffix == ".hinges" else f"p{suffix}")
     with pytest.raises(PatternError, match=rf"p\{suffix}: file is {size} bytes.*{size - 1}"):
-        fio.read(mesh, hinges=tmp_path / "p.hinges" if suffix != ".fold" else None)
+        fio.read(mesh, hinges=tmp_path / "p.hinges" if suffix not in (".fold", ".cp")
+                 else None)
     assert str(too_big) not in opened
 
 

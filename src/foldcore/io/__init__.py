@@ -37,6 +37,10 @@ def read(path, *, hinges=None, reading: Reading | None = None) -> CreasePattern:
     return read_file(path, hinges=hinges, reading=reading).pattern
 
 
+#: What each suffix without a hinge file is, for messages.
+_KINDS = {".fold": "a FOLD file", ".svg": "an SVG", ".cp": "a .cp file"}
+
+
 def read_file(path, *, hinges=None, reading: Reading | None = None) -> FoldFile:
     """Read a crease-pattern file of any kind: the one place that dispatches on the suffix.
 
@@ -44,7 +48,8 @@ def read_file(path, *, hinges=None, reading: Reading | None = None) -> FoldFile:
     ----------
     path : str or os.PathLike
         ``.fold`` (FOLD JSON), ``.svg`` (Origami Simulator's colours,
-        :mod:`.svg`), or ``.obj`` / ``.stl`` (2D polygon mesh, mm).
+        :mod:`.svg`), ``.cp`` (ORIPA's lines, :mod:`.cp`), or ``.obj`` / ``.stl``
+        (2D polygon mesh, mm).
     hinges : str or os.PathLike, optional
         Hinge file of a mesh; default: the mesh path with suffix ``.hinges``.
         Only with an OBJ/STL mesh.
@@ -69,21 +74,24 @@ def read_file(path, *, hinges=None, reading: Reading | None = None) -> FoldFile:
     source = os.fspath(path)
     suffix = Path(source).suffix.lower()
     reading = Reading() if reading is None else reading
-    if suffix in (".fold", ".svg") and hinges is not None:
+    if suffix in (".fold", ".svg", ".cp") and hinges is not None:
         raise PatternError(f"{source}: a hinge file only goes with an OBJ/STL mesh, "
-                           f"not {'a FOLD file' if suffix == '.fold' else 'an SVG'}")
+                           f"not {_KINDS[suffix]}")
     for given in (source, hinges):  # before any is opened: a named pipe blocks a read
-        if given is not None and suffix in (".fold", ".svg", *MESH_SUFFIXES):
+        if given is not None and suffix in (".fold", ".svg", ".cp", *MESH_SUFFIXES):
             check_input(given, PatternError)
     if suffix == ".fold":
         return read_fold_file(source, reading)
     if suffix == ".svg":
         from .svg import read_svg  # svgelements only when an SVG is read
         return FoldFile(read_svg(source, reading), None, "mm")
+    if suffix == ".cp":
+        from .cp import read_cp
+        return FoldFile(read_cp(source, reading), None, "mm")
     if suffix in MESH_SUFFIXES:
         if reading.scale is not None or reading.size is not None:
             raise PatternError(f"{source}: a scale or sheet size applies to FOLD and SVG "
                                "patterns; an OBJ/STL mesh is read in mm")
         return FoldFile(read_mesh(source, hinges), None, "mm")
     raise PatternError(f"{source}: unknown crease-pattern file type {suffix or '(no suffix)'!r}"
-                       " (expected .fold, .svg, .obj or .stl)")
+                       " (expected .fold, .svg, .cp, .obj or .stl)")

@@ -24,12 +24,13 @@ once with a count. Curved segments are refused (panels are planar): an SVG
 path's Bézier or arc segment whose control points are off its chord by more
 than 1e-4 of its chord names its element.
 
-Planarisation (shapely): endpoints within ``SNAP_PX`` = 3 px (Origami
-Simulator's vertex tolerance; at most 1 % of the sheet) of another segment are
-moved onto it (T-joins drawn a little short or long), the segments are noded
-— every crossing and overlap becomes a shared vertex — and vertices within
-that distance are merged (an overlapped piece is one edge). Each piece takes the type of the segments it
-lies on; two different types on one piece are refused, naming both elements.
+Planarisation (:mod:`.lines`, shapely) at ``SNAP_PX`` = 3 px (Origami
+Simulator's vertex tolerance; at most 1 % of the sheet): endpoints that near
+another segment are moved onto it (T-joins drawn a little short or long), the
+segments are noded — every crossing and overlap becomes a shared vertex —
+and vertices that near are merged (an overlapped piece is one edge). Each
+piece takes the type of the segments it lies on; two different types on one
+piece are refused, naming both elements.
 
 Lengths: SVG user units are CSS pixels, 1 px = 25.4 / 96 mm; ``Reading.scale``
 or ``Reading.size`` rescale. y is flipped (SVG's y points down), so the
@@ -46,6 +47,7 @@ import numpy as np
 from ..errors import PatternError
 from ..pattern import CreasePattern
 from .conventions import Reading, note
+from .lines import check_meetings, pattern_from_lines
 from .svg_screen import screened_svg
 
 MM_PER_PX = 25.4 / 96.0  # CSS pixel
@@ -57,9 +59,6 @@ SNAP_MAX = 1e-2
 #: A Bézier or arc segment is straight if its points are off its chord by at most this
 #: share of the chord (Illustrator exports round coordinates to 1e-3 px).
 STRAIGHT = 1e-4
-#: A piece lies along a segment if the sine of the angle between them is at most this
-#: (a piece near a crossing is near both segments but along one).
-PARALLEL = 0.1
 #: Stroke (r, g, b) → (assignment, sign of the target: -1 mountain, +1 valley, 0 none).
 STROKES = {(0, 0, 0): ("B", 0.0), (255, 0, 0): ("M", -1.0), (0, 0, 255): ("V", 1.0),
            (255, 255, 0): ("F", 0.0), (255, 0, 255): ("U", 0.0), (0, 255, 0): ("C", 0.0)}
@@ -68,12 +67,6 @@ STROKES = {(0, 0, 0): ("B", 0.0), (255, 0, 0): ("M", -1.0), (0, 0, 255): ("V", 1
 MAX_COORD_PX = 1e9
 #: Most straight segments in one pattern ...
 MAX_SEGMENTS = 200_000
-#: ... and most pairs of them that meet or cross (each a vertex to node; Origami
-#: Simulator's library has at most 16 782, and noding 10⁵ takes about 2 s).
-MAX_MEETINGS = 100_000
-#: Most pairs of noded points closer than the merge distance (a few per T-join or
-#: crossing in a drawing; many lines through one point crowd there by the million).
-MAX_CLOSE_PAIRS = 1_000_000
 #: An SVG number, and one followed by a unit (a length).
 _NUMBER = re.compile(r"([+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)")
 _LENGTH = re.compile(_NUMBER.pattern + r"\s*(?:px|mm|cm|in|pt|pc|em|ex|%)?")
@@ -102,16 +95,13 @@ def read_svg(path, reading: Reading | None = None) -> CreasePattern:
         raise PatternError(f"{source}: no stroked lines in Origami Simulator's colours "
                            "(red mountain, blue valley, black boundary, yellow facet, "
                            "magenta undriven)")
-    _check_meetings(segments, source)
+    check_meetings(segments, source)
     segments[:, :, 1] *= -1.0  # SVG y points down
     extent = float(np.ptp(segments.reshape(-1, 2), axis=0).max())
-    tol = min(SNAP_PX, SNAP_MAX * extent)
-    vertices, edges, pieces = _planarise(segments, tol, source)
-    assignments, fold_angles = _piece_types(pieces, edges, vertices, segments, kinds,
-                                            angles, owners, tol, source)
-    factor = reading.factor(extent * MM_PER_PX) * MM_PER_PX
-    return CreasePattern(vertices * factor, edges, assignments, fold_angles=fold_angles,
-                         source=source)
+    return pattern_from_lines(segments, kinds, angles, owners, source,
+                              tol=min(SNAP_PX, SNAP_MAX * extent),
+                              factor=reading.factor(extent * MM_PER_PX) * MM_PER_PX,
+                              where=lambda x, y: f"({x:g}, {-y:g}) px")
 
 
 def _strokes(source: str):
@@ -238,25 +228,6 @@ def _failure(exc: BaseException) -> str:
     return f"{type(exc).__name__}: {' '.join(str(exc).split())[:120]}"
 
 
-def _check_meetings(segments: np.ndarray, source: str) -> None:
-    """Refuse a drawing whose segments meet or cross more than :data:`MAX_MEETINGS`
-    times (each meeting a vertex the noding creates; counted in chunks so that the
-    count stops once past the bound)."""
-    import shapely
-
-    lines = shapely.linestrings(segments)
-    tree = shapely.STRtree(lines)
-    chunk = max(64, 2_000_000 // max(len(lines), 1))
-    total = 0
-    for start in range(0, len(lines), chunk):
-        first, second = tree.query(lines[start:start + chunk], predicate="intersects")
-        total += int(np.count_nonzero(first + start < second))
-        if total > MAX_MEETINGS:
-            raise PatternError(f"{source}: its {len(lines)} segments meet or cross more "
-                               f"than {MAX_MEETINGS} times; foldcore reads crease "
-                               "patterns, not hatchings")
-
-
 def _element_name(element, number: int) -> str:
     tag = type(element).__name__.lower().replace("simpleline", "line")
     ident = element.values.get("id")
@@ -304,121 +275,3 @@ def _check_straight(seg, a: np.ndarray, b: np.ndarray, name: str, source: str) -
                                "draw creases as straight lines")
 
 
-def _planarise(segments: np.ndarray, tol: float, source: str = "<segments>"):
-    """(V, 2) vertices, (E, 2) edges and the (E, 2, 2) noded pieces of the segments:
-    endpoints snapped onto nearby segments, near coordinates merged, crossings and
-    overlaps noded (shapely's unary union)."""
-    import shapely
-
-    segments = _snap_endpoints(segments, tol)
-    lines = shapely.linestrings(segments)
-    noded = shapely.unary_union(shapely.set_precision(lines, tol))
-    pieces = []
-    for part in shapely.get_parts(noded):
-        xy = shapely.get_coordinates(part)
-        pieces.extend(zip(xy[:-1], xy[1:]))
-    pieces = np.array(pieces, dtype=np.float64).reshape(-1, 2, 2)
-    vertices, ids = _merge_close(pieces.reshape(-1, 2), tol, source)
-    edges = np.sort(ids.reshape(-1, 2), axis=1)
-    keep = edges[:, 0] != edges[:, 1]  # a piece shorter than tol: its ends merged
-    edges, first = np.unique(edges[keep], axis=0, return_index=True)
-    used, edges = np.unique(edges, return_inverse=True)
-    return vertices[used], edges.reshape(-1, 2), pieces[keep][first]
-
-
-def _merge_close(points: np.ndarray, tol: float, source: str):
-    """(V, 2) points with every cluster closer than ``tol`` (transitively) replaced by
-    its mean, and each input point's id (several crossings rounded apart at one
-    vertex, a T-join's ends); refused where more than :data:`MAX_CLOSE_PAIRS` pairs
-    are that close (counted before they are listed)."""
-    import scipy.sparse as sp
-    from scipy.sparse.csgraph import connected_components
-    from scipy.spatial import cKDTree
-
-    unique, ids = np.unique(points, axis=0, return_inverse=True)
-    tree = cKDTree(unique)
-    close = (int(tree.count_neighbors(tree, tol)) - len(unique)) // 2
-    if close > MAX_CLOSE_PAIRS:
-        raise PatternError(f"{source}: {close} pairs of its crossings lie within the "
-                           f"merge distance {tol:g} px of each other (more than "
-                           f"{MAX_CLOSE_PAIRS}): too many lines through one place")
-    pairs = tree.query_pairs(tol, output_type="ndarray")
-    graph = sp.coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])),
-                          shape=(len(unique), len(unique)))
-    _, cluster = connected_components(graph, directed=False)
-    merged = np.zeros((cluster.max() + 1 if len(cluster) else 0, 2))
-    np.add.at(merged, cluster, unique)
-    merged /= np.bincount(cluster)[:, None]
-    return merged, cluster[ids.ravel()]
-
-
-def _snap_endpoints(segments: np.ndarray, tol: float) -> np.ndarray:
-    """Move each endpoint within ``tol`` of another segment onto that segment (a T-join
-    drawn a little short or long), keeping endpoints that already meet one."""
-    import shapely
-
-    out = segments.copy()
-    lines = shapely.linestrings(segments)
-    tree = shapely.STRtree(lines)
-    ends = shapely.points(segments.reshape(-1, 2))
-    point_ids, line_ids = tree.query(ends, predicate="dwithin", distance=tol)
-    own = point_ids // 2 == line_ids
-    for p, s in zip(point_ids[~own], line_ids[~own]):
-        here = out[p // 2, p % 2]
-        a, b = segments[s]
-        d = b - a
-        t = float(np.clip(np.dot(here - a, d) / float(np.dot(d, d)), 0.0, 1.0))
-        target = a + t * d
-        if np.hypot(*(target - here)) <= tol:
-            out[p // 2, p % 2] = target
-    return out
-
-
-def _piece_types(pieces, edges, vertices, segments, kinds, angles, owners, tol, source):
-    """Each piece's assignment and target: those of the segments it lies along — its
-    midpoint within ``tol`` and both ends within 2 ``tol`` of the segment, and its
-    direction within ``PARALLEL`` (sine) of the segment's; two different ones are
-    refused. A piece near a crossing is also near the crossing segment but not along
-    it; a short piece whose merged ends turned it by more is typed by the segment
-    closest to its direction, one whose ends merged farther by the nearest segment."""
-    import shapely
-
-    lines = shapely.linestrings(segments)
-    tree = shapely.STRtree(lines)
-    ends = vertices[edges]  # (E, 2, 2), after merging
-    piece_ids, seg_ids = tree.query(shapely.points(ends.mean(axis=1)), predicate="dwithin",
-                                    distance=tol)
-    along = np.maximum(shapely.distance(shapely.points(ends[piece_ids, 0]), lines[seg_ids]),
-                       shapely.distance(shapely.points(ends[piece_ids, 1]), lines[seg_ids]))
-    piece_ids, seg_ids = piece_ids[along <= 2.0 * tol], seg_ids[along <= 2.0 * tol]
-    sine = np.abs(_cross(_unit(ends[piece_ids, 1] - ends[piece_ids, 0]),
-                         _unit(segments[seg_ids, 1] - segments[seg_ids, 0])))
-    assignment = np.full(len(pieces), "", dtype="<U1")
-    target = np.full(len(pieces), np.nan)
-    owner = [None] * len(pieces)
-    for p in np.unique(piece_ids):
-        mine = np.flatnonzero(piece_ids == p)
-        parallel = mine[sine[mine] <= PARALLEL]
-        chosen = parallel if len(parallel) else mine[[int(np.argmin(sine[mine]))]]
-        for s in seg_ids[chosen]:
-            same = assignment[p] == kinds[s] and (np.isnan(target[p]) and np.isnan(angles[s])
-                                                  or target[p] == angles[s])
-            if owner[p] is None:
-                assignment[p], target[p], owner[p] = kinds[s], angles[s], owners[s]
-            elif not same:
-                raise PatternError(f"{source}: {owners[s]} and {owner[p]} overlap with "
-                                   f"different crease types or angles ({kinds[s]} and "
-                                   f"{assignment[p]}) near ({vertices[edges[p, 0]][0]:g}, "
-                                   f"{-vertices[edges[p, 0]][1]:g}) px")
-    for p in [q for q, o in enumerate(owner) if o is None]:  # its ends merged far off
-        s = int(tree.query_nearest(shapely.points(ends[p].mean(axis=0)))[0])
-        assignment[p], target[p] = kinds[s], angles[s]
-    return assignment.tolist(), [None if np.isnan(t) else float(t) for t in target]
-
-
-def _unit(d: np.ndarray) -> np.ndarray:
-    return d / np.maximum(np.hypot(d[:, 0], d[:, 1]), 1e-300)[:, None]
-
-
-def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    return a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]

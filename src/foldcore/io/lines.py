@@ -1,0 +1,197 @@
+"""Line drawings to crease patterns: the noding that SVG and ``.cp`` files share.
+
+A drawing is (S, 2, 2) straight segments, each with a crease type (FOLD's
+``M V B F U``), a target angle (degrees, NaN passive) and an owner (the
+element or line that drew it, for messages). :func:`pattern_from_lines`
+snaps endpoints within ``tol`` onto nearby segments (T-joins drawn a little
+short or long), nodes every crossing and overlap into a shared vertex
+(shapely's unary union), merges vertices within ``tol`` and types each piece
+by the segments it lies along (two different types on one piece are
+refused, naming both owners). Bounds checked before the work: at most
+:data:`MAX_MEETINGS` meetings of segments and :data:`MAX_CLOSE_PAIRS` close
+pairs of noded points.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import PatternError
+from ..pattern import CreasePattern
+
+#: Most pairs of segments that meet or cross (each a vertex to node; Origami
+#: Simulator's library has at most 16 782, and noding 10⁵ takes about 2 s).
+MAX_MEETINGS = 100_000
+#: Most pairs of noded points closer than the merge distance (a few per T-join or
+#: crossing in a drawing; many lines through one point crowd there by the million).
+MAX_CLOSE_PAIRS = 1_000_000
+#: A piece lies along a segment if the sine of the angle between them is at most this
+#: (a piece near a crossing is near both segments but along one).
+PARALLEL = 0.1
+
+
+def pattern_from_lines(segments: np.ndarray, kinds, angles, owners, source: str, *,
+                       tol: float, factor: float = 1.0, where=None) -> CreasePattern:
+    """The crease pattern of a line drawing (module docstring).
+
+    Parameters
+    ----------
+    segments : (S, 2, 2) float
+        Straight segments, the file's units.
+    kinds, angles, owners : sequences of length S
+        Crease type (``M V B F U``), target angle (degrees, NaN: none), owner name.
+    source : str
+        The file, for messages.
+    tol : float
+        Snap and merge distance, the file's units.
+    factor : float
+        mm per file unit.
+    where : callable(x, y) -> str, optional
+        A place in the file's words, for messages (default ``(x, y)``).
+    """
+    vertices, edges, pieces = planarise(segments, tol, source)
+    extra = {} if where is None else {"where": where}
+    assignments, fold_angles = piece_types(pieces, edges, vertices, segments, kinds,
+                                           angles, owners, tol, source, **extra)
+    return CreasePattern(vertices * factor, edges, assignments, fold_angles=fold_angles,
+                         source=source)
+
+
+def check_meetings(segments: np.ndarray, source: str) -> None:
+    """Refuse a drawing whose segments meet or cross more than :data:`MAX_MEETINGS`
+    times (each meeting a vertex the noding creates; counted in chunks so that the
+    count stops once past the bound)."""
+    import shapely
+
+    lines = shapely.linestrings(segments)
+    tree = shapely.STRtree(lines)
+    chunk = max(64, 2_000_000 // max(len(lines), 1))
+    total = 0
+    for start in range(0, len(lines), chunk):
+        first, second = tree.query(lines[start:start + chunk], predicate="intersects")
+        total += int(np.count_nonzero(first + start < second))
+        if total > MAX_MEETINGS:
+            raise PatternError(f"{source}: its {len(lines)} segments meet or cross more "
+                               f"than {MAX_MEETINGS} times; foldcore reads crease "
+                               "patterns, not hatchings")
+
+
+
+def planarise(segments: np.ndarray, tol: float, source: str = "<segments>"):
+    """(V, 2) vertices, (E, 2) edges and the (E, 2, 2) noded pieces of the segments:
+    endpoints snapped onto nearby segments, near coordinates merged, crossings and
+    overlaps noded (shapely's unary union)."""
+    import shapely
+
+    segments = _snap_endpoints(segments, tol)
+    lines = shapely.linestrings(segments)
+    noded = shapely.unary_union(shapely.set_precision(lines, tol))
+    pieces = []
+    for part in shapely.get_parts(noded):
+        xy = shapely.get_coordinates(part)
+        pieces.extend(zip(xy[:-1], xy[1:]))
+    pieces = np.array(pieces, dtype=np.float64).reshape(-1, 2, 2)
+    vertices, ids = _merge_close(pieces.reshape(-1, 2), tol, source)
+    edges = np.sort(ids.reshape(-1, 2), axis=1)
+    keep = edges[:, 0] != edges[:, 1]  # a piece shorter than tol: its ends merged
+    edges, first = np.unique(edges[keep], axis=0, return_index=True)
+    used, edges = np.unique(edges, return_inverse=True)
+    return vertices[used], edges.reshape(-1, 2), pieces[keep][first]
+
+
+def _merge_close(points: np.ndarray, tol: float, source: str):
+    """(V, 2) points with every cluster closer than ``tol`` (transitively) replaced by
+    its mean, and each input point's id (several crossings rounded apart at one
+    vertex, a T-join's ends); refused where more than :data:`MAX_CLOSE_PAIRS` pairs
+    are that close (counted before they are listed)."""
+    import scipy.sparse as sp
+    from scipy.sparse.csgraph import connected_components
+    from scipy.spatial import cKDTree
+
+    unique, ids = np.unique(points, axis=0, return_inverse=True)
+    tree = cKDTree(unique)
+    close = (int(tree.count_neighbors(tree, tol)) - len(unique)) // 2
+    if close > MAX_CLOSE_PAIRS:
+        raise PatternError(f"{source}: {close} pairs of its crossings lie within the "
+                           f"merge distance {tol:g} of each other (more than "
+                           f"{MAX_CLOSE_PAIRS}): too many lines through one place")
+    pairs = tree.query_pairs(tol, output_type="ndarray")
+    graph = sp.coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])),
+                          shape=(len(unique), len(unique)))
+    _, cluster = connected_components(graph, directed=False)
+    merged = np.zeros((cluster.max() + 1 if len(cluster) else 0, 2))
+    np.add.at(merged, cluster, unique)
+    merged /= np.bincount(cluster)[:, None]
+    return merged, cluster[ids.ravel()]
+
+
+def _snap_endpoints(segments: np.ndarray, tol: float) -> np.ndarray:
+    """Move each endpoint within ``tol`` of another segment onto that segment (a T-join
+    drawn a little short or long), keeping endpoints that already meet one."""
+    import shapely
+
+    out = segments.copy()
+    lines = shapely.linestrings(segments)
+    tree = shapely.STRtree(lines)
+    ends = shapely.points(segments.reshape(-1, 2))
+    point_ids, line_ids = tree.query(ends, predicate="dwithin", distance=tol)
+    own = point_ids // 2 == line_ids
+    for p, s in zip(point_ids[~own], line_ids[~own]):
+        here = out[p // 2, p % 2]
+        a, b = segments[s]
+        d = b - a
+        t = float(np.clip(np.dot(here - a, d) / float(np.dot(d, d)), 0.0, 1.0))
+        target = a + t * d
+        if np.hypot(*(target - here)) <= tol:
+            out[p // 2, p % 2] = target
+    return out
+
+
+def piece_types(pieces, edges, vertices, segments, kinds, angles, owners, tol, source,
+                where=lambda x, y: f"({x:g}, {y:g})"):
+    """Each piece's assignment and target: those of the segments it lies along — its
+    midpoint within ``tol`` and both ends within 2 ``tol`` of the segment, and its
+    direction within ``PARALLEL`` (sine) of the segment's; two different ones are
+    refused (``where(x, y)``: the place in the file's words). A piece near a crossing
+    is also near the crossing segment but not along it; a short piece whose merged
+    ends turned it by more is typed by the segment closest to its direction, one
+    whose ends merged farther by the nearest segment."""
+    import shapely
+
+    lines = shapely.linestrings(segments)
+    tree = shapely.STRtree(lines)
+    ends = vertices[edges]  # (E, 2, 2), after merging
+    piece_ids, seg_ids = tree.query(shapely.points(ends.mean(axis=1)), predicate="dwithin",
+                                    distance=tol)
+    along = np.maximum(shapely.distance(shapely.points(ends[piece_ids, 0]), lines[seg_ids]),
+                       shapely.distance(shapely.points(ends[piece_ids, 1]), lines[seg_ids]))
+    piece_ids, seg_ids = piece_ids[along <= 2.0 * tol], seg_ids[along <= 2.0 * tol]
+    sine = np.abs(_cross(_unit(ends[piece_ids, 1] - ends[piece_ids, 0]),
+                         _unit(segments[seg_ids, 1] - segments[seg_ids, 0])))
+    assignment = np.full(len(pieces), "", dtype="<U1")
+    target = np.full(len(pieces), np.nan)
+    owner = [None] * len(pieces)
+    for p in np.unique(piece_ids):
+        mine = np.flatnonzero(piece_ids == p)
+        parallel = mine[sine[mine] <= PARALLEL]
+        chosen = parallel if len(parallel) else mine[[int(np.argmin(sine[mine]))]]
+        for s in seg_ids[chosen]:
+            same = assignment[p] == kinds[s] and (np.isnan(target[p]) and np.isnan(angles[s])
+                                                  or target[p] == angles[s])
+            if owner[p] is None:
+                assignment[p], target[p], owner[p] = kinds[s], angles[s], owners[s]
+            elif not same:
+                raise PatternError(f"{source}: {owners[s]} and {owner[p]} overlap with "
+                                   f"different crease types or angles ({kinds[s]} and "
+                                   f"{assignment[p]}) near {where(*vertices[edges[p, 0]])}")
+    for p in [q for q, o in enumerate(owner) if o is None]:  # its ends merged far off
+        s = int(tree.query_nearest(shapely.points(ends[p].mean(axis=0)))[0])
+        assignment[p], target[p] = kinds[s], angles[s]
+    return assignment.tolist(), [None if np.isnan(t) else float(t) for t in target]
+
+
+def _unit(d: np.ndarray) -> np.ndarray:
+    return d / np.maximum(np.hypot(d[:, 0], d[:, 1]), 1e-300)[:, None]
+
+
+def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
