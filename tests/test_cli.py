@@ -286,6 +286,28 @@ def test_a_signal_during_the_writes_leaves_no_file(fold_file, tmp_path, capsys,
     assert signal.getsignal(signal.SIGTERM) is signal.SIG_DFL  # the handler is put back
 
 
+def test_a_render_that_fails_keeps_the_result(fold_file, tmp_path, capsys, monkeypatch):
+    """A picture the renderer cannot make (here: VTK failing) is one line naming it,
+    exit 2, and takes neither the result FOLD nor the report with it."""
+    from foldcore import render
+
+    def broken(*args, **kw):
+        raise RuntimeError("vtkOpenGLRenderWindow: no display\n(details)")
+
+    monkeypatch.setattr(render, "render_png", broken)
+    out_dir = tmp_path / "out"
+    out_dir.mkdir()
+    fold, report, png = out_dir / "o.fold", out_dir / "r.json", out_dir / "p.png"
+    assert main(["simulate", str(fold_file), "-o", str(fold), "--report", str(report),
+                 "--render", str(png)]) == 2
+    (line,) = capsys.readouterr().err.splitlines()
+    assert f"{png}: the picture was not written (vtkOpenGLRenderWindow: no display " \
+           "(details)); the other outputs were:" in line
+    assert str(fold) in line and str(report) in line
+    assert sorted(p.name for p in out_dir.iterdir()) == ["o.fold", "r.json"]  # no temp
+    assert json.loads(report.read_text())["converged"]
+
+
 def test_version_and_a_render_that_is_not_png(fold_file, tmp_path, capsys):
     """`--version` exists; `--render out.jpg` (a PNG render under a .jpg name) is
     refused before the run."""

@@ -7,7 +7,8 @@
 Reads the pattern (:mod:`foldcore.io`, Origami Simulator's conventions:
 :mod:`foldcore.io.conventions`), checks every output path before any work
 (:mod:`foldcore.destinations`), thickens, runs the simulation at the fold
-percent (or along an animation's sweep) and writes the outputs all or nothing
+percent (or along an animation's sweep) and writes the outputs (the data files
+all or nothing, then the picture)
 (:mod:`foldcore.outputs`). Warnings the run calls for — nothing driven, or
 converged with its targets missed — are :class:`foldcore.errors.RunWarning`.
 Every option is in one of four groups (:mod:`foldcore.options`), with the
@@ -66,7 +67,8 @@ def simulate(path, *, hinges=None, reading=None, thickening=None, solving=None,
         Fold percent, strategy, tolerance, budget, actuation, branch floor.
     outputs : foldcore.options.Outputs or dict, optional
         Result FOLD, JSON report, PNG render, animation, series (paths; checked
-        before any work, written all or nothing).
+        before any work; the data files written all or nothing, then the PNG:
+        an OutputError naming it if it cannot be rendered, the others kept).
     callback : callable(sim, moved_mm) -> bool or None, optional
         Called after each iteration (:meth:`Simulation.run`); False stops the run.
 

@@ -173,7 +173,8 @@ class Solving:
 
 @dataclass(frozen=True)
 class Outputs:
-    """What is written (each checked before any work; all or nothing).
+    """What is written (each checked before any work; the data files all or nothing,
+    then the picture, whose failure does not take them with it).
 
     Attributes
     ----------

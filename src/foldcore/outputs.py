@@ -302,9 +302,12 @@ def write_result(result, pattern, mesh, thickness: float, settings: dict, *, fol
         None skips it (and, for ``png``, the pyvista import). The FOLD file's
         ``edges_foldAngle`` holds the achieved angles within FOLD's [−180°, 180°]
         (a crease folded past flat on its assigned side, e.g. −180.54°, is written
-        −180°; the report keeps the measured value). All or nothing: every
-        file is written to a temporary name first and renamed only when all are
-        written (:func:`foldcore.files.all_or_nothing`).
+        −180°; the report keeps the measured value). The data files (FOLD,
+        report, series) are written all or nothing: each to a temporary name
+        first, renamed only when all are written
+        (:func:`foldcore.files.all_or_nothing`). The PNG comes after them, on
+        its own: a picture the renderer cannot make raises an OutputError naming
+        it, with the data files written.
     quantities : dict, optional
         A scene's own measurements, stored in the report.
     partial : bool
@@ -320,20 +323,13 @@ def write_result(result, pattern, mesh, thickness: float, settings: dict, *, fol
     """
     from .files import all_or_nothing
 
-    with all_or_nothing({"png": png, "fold": fold, "report": report,
-                         "series": series}) as tmp:
+    with all_or_nothing({"fold": fold, "report": report, "series": series}) as tmp:
         if series:
             from .io import write_fold
             write_fold(tmp["series"], pattern,
                        achieved_angles=in_fold_range(result.fold_angles_deg),
                        frames=[series_frame(mesh, r, p) for p, r in sweep],
                        thickness=thickness, extra=_mesh_recipe(pattern, mesh))
-        if png and picture is not None:
-            import imageio.v3 as iio
-            iio.imwrite(tmp["png"], picture, extension=".png")
-        elif png:
-            from .render import render_png
-            render_png(pattern, mesh, result.positions, tmp["png"])
         if fold:
             from .io import write_fold
             extra = {**(_mesh_recipe(pattern, mesh) or {}),
@@ -346,3 +342,27 @@ def write_result(result, pattern, mesh, thickness: float, settings: dict, *, fol
             write_report(tmp["report"], {**report_dict(result, pattern, mesh, settings,
                                                        quantities),
                                          **({"partial": True} if partial else {})})
+    if png:
+        _write_picture(png, pattern, mesh, result, picture,
+                       written=[p for p in (fold, report, series) if p])
+
+
+def _write_picture(png, pattern, mesh, result, picture, written: list) -> None:
+    """The PNG (``picture``, or a render of ``result``), atomically, after the data
+    files; an OutputError naming it, and the files already written, if it fails
+    (a run's result is not lost to its picture)."""
+    from .files import OutputError, atomic_path
+
+    try:
+        if picture is not None:
+            import imageio.v3 as iio
+            with atomic_path(png) as tmp:
+                iio.imwrite(tmp, picture, extension=".png")
+        else:
+            from .render import render_png
+            render_png(pattern, mesh, result.positions, png)
+    except Exception as exc:  # whatever the renderer raised: said, the data kept
+        reason = " ".join(str(exc).split())[:300] or type(exc).__name__
+        raise OutputError(f"{png}: the picture was not written ({reason})"
+                          + (f"; the other outputs were: {', '.join(map(str, written))}"
+                             if written else "")) from None
