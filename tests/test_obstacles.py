@@ -148,8 +148,13 @@ def test_command_line_obstacles(tmp_path):
     assert [o["name"] for o in report["contact"]["obstacles"]] == ["cube.obj", "ground"]
     assert max(report["fold_angles_deg"][:2]) < 150.0
     (tmp_path / "junk.obj").write_text("v 0 0\nf 1 2 9\n")
-    for extra in (["--obstacle", str(tmp_path / "junk.obj")], ["--ground", "0"]):
+    for extra in (["--obstacle", str(tmp_path / "junk.obj")], ["--ground", "0"],
+                  ["--ground", "10"]):  # through the sheet, above it: refused before the run
         refused = subprocess.run(cli[:7] + extra, capture_output=True, text=True)
         assert refused.returncode == 2 and "Traceback" not in refused.stderr
+        assert refused.stderr.count("\n") == 1, refused.stderr
+    ground = subprocess.run(cli[:7] + ["--ground", "10"], capture_output=True, text=True)
+    assert f"--ground = 10 mm is not below the flat sheet, whose bottom face is at z = " \
+           f"{-0.5 * H:g} mm" in ground.stderr
     assert "junk.obj" in subprocess.run(cli[:7] + ["--obstacle", str(tmp_path / "junk.obj")],
                                         capture_output=True, text=True).stderr

@@ -208,6 +208,11 @@ def _prepared(job: Job):
     if thickness is None:
         raise OptionError(f"{job.source}: no thickness: give thickening.thickness (mm) "
                           "or set foldcore:thickness in the file")
+    ground = job.solving.ground
+    if ground is not None and not ground < -0.5 * thickness:
+        raise OptionError(f"{job.source}: solving.ground = {ground:g} mm is not below the "
+                          f"flat sheet, whose bottom face is at z = {-0.5 * thickness:g} mm "
+                          "(the ground faces up and holds the sheet from below)")
     for path in job.solving.obstacles:  # read after thickening: checked now
         check_input(path)
     check_destinations(job.outputs.paths(), inputs=(job.source, job.hinges),

@@ -127,10 +127,10 @@ class Solving:
         Mesh files (STL, OBJ, PLY, … in mm, the pattern's frame: the flat sheet's
         mid-surface is z = 0) of fixed obstacles the sheet touches but never passes.
     ground : float, optional
-        Height z (mm) of a horizontal plane facing up that the sheet never passes
-        (below −H/2: the flat sheet's bottom face); |z| at most 1e4 × the sheet's
-        extent (:data:`foldcore.limits.GROUND_RATIO`, checked once the pattern is
-        read).
+        Height z (mm) of a horizontal plane facing up that the sheet never passes;
+        below −H/2, the flat sheet's bottom face, and |z| at most 1e4 × the
+        sheet's extent (:data:`foldcore.limits.GROUND_RATIO`; both checked once
+        the pattern is read).
     """
 
     fold_percent: float = 100.0
