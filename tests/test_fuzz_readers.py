@@ -662,15 +662,21 @@ def svg_documents(draw) -> bytes:
     return text
 
 
+def read_written(fuzz_dir, name: str, blob: bytes):
+    """``blob`` written as ``name`` in ``fuzz_dir``, through :func:`foldcore.io.read`
+    (:func:`outcome`)."""
+    path = os.path.join(fuzz_dir, name)
+    with open(path, "wb") as fh:
+        fh.write(blob)
+    return outcome(lambda: fio.read(path), path)
+
+
 @FUZZ
 @given(blob=svg_documents())
 def test_fuzz_svg(fuzz_dir, blob):
     """Generated drawings through :func:`foldcore.io.read`: a valid pattern or one
     line naming the file."""
-    path = os.path.join(fuzz_dir, "p.svg")
-    with open(path, "wb") as fh:
-        fh.write(blob)
-    outcome(lambda: fio.read(path), path)
+    read_written(fuzz_dir, "p.svg", blob)
 
 
 _REAL_SVG = sorted(p for p in os.listdir("tests/data/real") if p.endswith(".svg"))
@@ -687,10 +693,7 @@ def test_fuzz_svg_mutated_real_files(fuzz_dir, name, cuts):
     for where, length, insert in cuts:
         at = int(where * len(blob))
         blob[at:at + length] = insert
-    path = os.path.join(fuzz_dir, "m.svg")
-    with open(path, "wb") as fh:
-        fh.write(bytes(blob))
-    outcome(lambda: fio.read(path), path)
+    read_written(fuzz_dir, "m.svg", bytes(blob))
 
 
 _CP_SQUARE = ["1 0 0 100 0", "1 100 0 100 100", "1 100 100 0 100", "1 0 100 0 0"]
@@ -727,10 +730,7 @@ def cp_texts(draw) -> bytes:
 def test_fuzz_cp(fuzz_dir, blob):
     """Generated .cp files through :func:`foldcore.io.read`: a valid pattern or one
     line naming the file."""
-    path = os.path.join(fuzz_dir, "p.cp")
-    with open(path, "wb") as fh:
-        fh.write(blob)
-    outcome(lambda: fio.read(path), path)
+    read_written(fuzz_dir, "p.cp", blob)
 
 
 # -------------------------------------------------------- plain regressions

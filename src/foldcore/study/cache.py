@@ -40,15 +40,14 @@ def code_identity(function) -> str:
     import marshal
 
     parts = []
-    target = function
-    callables = [target]
-    if not hasattr(target, "__code__"):  # an object: its class's methods and its state
-        callables = [v for v in vars(type(target)).values() if hasattr(v, "__code__")]
-        parts.append(repr(sorted(getattr(target, "__dict__", {}).items(), key=str)))
+    callables = [function]
+    if not hasattr(function, "__code__"):  # an object: its class's methods and its state
+        callables = [v for v in vars(type(function)).values() if hasattr(v, "__code__")]
+        parts.append(repr(sorted(getattr(function, "__dict__", {}).items(), key=str)))
     for f in callables:
         parts += [marshal.dumps(f.__code__).hex(), repr(getattr(f, "__defaults__", None)),
                   repr(getattr(f, "__kwdefaults__", None))]
-    parts.append(getattr(target, "__qualname__", type(target).__qualname__))
+    parts.append(getattr(function, "__qualname__", type(function).__qualname__))
     return hashlib.sha256("\0".join(parts).encode()).hexdigest()
 
 
@@ -57,6 +56,12 @@ class Cache:
 
     def __init__(self, folder=None):
         self.folder = None if folder is None else Path(folder)
+
+    @classmethod
+    def at(cls, cache) -> "Cache":
+        """The cache a study's ``cache`` argument names: ``"default"``
+        (:func:`default_folder`), a folder, or None (no cache)."""
+        return cls(default_folder() if cache == "default" else cache)
 
     def get(self, key: str):
         """(row, result FOLD bytes or None), or None if the key is not cached."""

@@ -52,7 +52,7 @@ import math
 from contextlib import contextmanager
 from dataclasses import dataclass
 
-from .cache import Cache, default_folder, point_key
+from .cache import Cache, point_key
 from .points import (OPTIONS, SWITCHES, StudyError, canonical, check, describe, parse_set,
                      parse_value, split_values)
 from .sweep import FIGURES, TRAILING, table
@@ -203,7 +203,7 @@ def optimize(pattern, space: dict, objective: str, *, fixed: dict | None = None,
     goal = Goal.of(objective, constraints, minimize, metric is not None)
     _check_counts(trials, batch)
     search = _Search(source, dims, fixed, goal, metric,
-                     Cache(default_folder() if cache == "default" else cache))
+                     Cache.at(cache))
     search.run(_sampler(sampler, seed), trials, batch, progress,
                {"client": client, "scheduler": scheduler, "workers": workers})
     return search.result()

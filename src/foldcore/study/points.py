@@ -15,7 +15,7 @@ import json
 import math
 
 from ..errors import FoldcoreError
-from ..options import FLAGS
+from ..options import FLAGS, Solving
 
 #: Option groups a study may set, and the ``simulate`` fields it may not (lists,
 #: outputs: a study writes its own).
@@ -208,5 +208,10 @@ def paths(points: list[dict]) -> list[list[int]]:
         key = json.dumps({k: v for k, v in point.items() if k != FOLD_PERCENT},
                          sort_keys=True, default=str)
         groups.setdefault(key, []).append(i)
-    return [sorted(ids, key=lambda i: abs(points[i].get(FOLD_PERCENT, 100.0)))
+    return [sorted(ids, key=lambda i: abs(fold_percent(points[i])))
             for ids in groups.values()]
+
+
+def fold_percent(point: dict) -> float:
+    """The point's fold percent: its own, or ``simulate``'s default."""
+    return point.get(FOLD_PERCENT, Solving.fold_percent)

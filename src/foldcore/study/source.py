@@ -34,18 +34,18 @@ class PatternFile:
     @classmethod
     def read(cls, path, hinges=None) -> "PatternFile":
         """Read ``path`` (and its hinge file: ``hinges``, else PATH.hinges for OBJ/STL)
-        after the checks every input gets (:func:`foldcore.files.check_input`)."""
-        from ..files import check_input
+        as every reader reads a file (:func:`foldcore.io.fold.read_bytes`: a regular
+        file within the size limit)."""
+        from ..io import MESH_SUFFIXES
+        from ..io.fold import read_bytes
+        from ..io.obj import HINGE_SUFFIX
 
         name = os.fspath(path)
-        check_input(name)
-        if hinges is None and Path(name).suffix.lower() in (".obj", ".stl"):
-            guess = Path(name).with_suffix(".hinges")
+        if hinges is None and Path(name).suffix.lower() in MESH_SUFFIXES:
+            guess = Path(name).with_suffix(HINGE_SUFFIX)
             hinges = guess if guess.is_file() else None
-        if hinges is not None:
-            check_input(os.fspath(hinges))
-        return cls(name, Path(name).read_bytes(),
-                   None if hinges is None else Path(hinges).read_bytes())
+        return cls(name, read_bytes(name),
+                   None if hinges is None else read_bytes(os.fspath(hinges)))
 
     @property
     def label(self) -> str:
@@ -63,7 +63,9 @@ class PatternFile:
         """(path, hinge path) of this worker's copy, written on first use."""
         folder = _worker_folder() / self.key()[:16]
         path = folder / Path(self.name).name
-        hinge_path = path.with_suffix(".hinges") if self.hinges is not None else None
+        from ..io.obj import HINGE_SUFFIX
+
+        hinge_path = path.with_suffix(HINGE_SUFFIX) if self.hinges is not None else None
         if not path.exists():
             folder.mkdir(parents=True, exist_ok=True)
             if hinge_path is not None:

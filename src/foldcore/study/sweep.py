@@ -4,9 +4,10 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-from .cache import Cache, default_folder, point_key
+from .cache import Cache, point_key
 from .figures import FIGURES, TRAILING
-from .points import StudyError, check, grid as grid_points, paths as continuation_paths
+from .points import (StudyError, check, fold_percent, grid as grid_points,
+                     paths as continuation_paths)
 
 #: Figures that are counts or flags (kept so with a failed point's missing values).
 _KINDS = {"converged": "boolean", "binding": "boolean", "cached": "boolean",
@@ -72,7 +73,7 @@ def sweep(pattern, grid: dict | None = None, points: list | None = None, *, hing
     source = source_of(pattern, hinges)
     todo = _points(grid, points, source.parameters)
     plan = continuation_paths(todo) if continuation else [[i] for i in range(len(todo))]
-    store = Cache(default_folder() if cache == "default" else cache)
+    store = Cache.at(cache)
     keys = _keys(source.key(), todo, plan, metric)
     keep_dir = _keep_folder(keep)
     rows, missing = _from_cache(store, keys, plan, keep_dir)
@@ -122,7 +123,7 @@ def _keys(source_key: str, todo: list, plan: list, metric) -> list[str]:
         before = []
         for i in ids:
             keys[i] = point_key(source_key, todo[i], list(before), metric)
-            before.append(todo[i].get("fold-percent", 100.0))
+            before.append(fold_percent(todo[i]))
     return keys
 
 
