@@ -168,12 +168,12 @@ LAYERS = [
     ("foldcore.simulation", "foldcore.result"),
     ("foldcore.strategies",),
     ("foldcore.convergence", "foldcore.probe", "foldcore.certificate"),
-    ("foldcore.model",),
+    ("foldcore.model", "foldcore.sheet"),
     ("foldcore.system", "foldcore.linsolve", "foldcore.threads"),
     ("foldcore.thickening", "foldcore.io", "foldcore.pattern", "foldcore.mesh",
      "foldcore.measure", "foldcore.strain", "foldcore.patterns", "foldcore.planar",
      "foldcore.kinematics", "foldcore.limits", "foldcore.hinges", "foldcore.actuation",
-     "foldcore.errors", "foldcore.files", "elements"),
+     "foldcore.errors", "foldcore.files", "foldcore.triangulation", "elements"),
 ]
 
 

@@ -15,121 +15,14 @@ Design notes: ``docs/architecture.md#triangulating-the-outer-surface``.
 """
 from __future__ import annotations
 
-import mapbox_earcut
 import numpy as np
 
 from . import files
 from .files import ExportError
 from .io.obj import STL_RECORD
 from .mesh import SurfaceFaces, surface_polygons
-
-#: Relative tolerance of a triangulation's area to its polygon's (mm² per mm²).
-AREA_TOLERANCE = 1e-9
-
-
-class TriangulationError(ExportError):
-    """A face's polygon cannot be triangulated into its own area (not simple)."""
-
-
-def triangulate_polygon(xy, face: int | None = None) -> np.ndarray:
-    """Triangles of a simple polygon, (n−2, 3) int64 local indices (mapbox-earcut).
-
-    Parameters
-    ----------
-    xy : (n, 2) float
-        Vertices in order, mm (either orientation; collinear points allowed).
-    face : int, optional
-        The face's index, named in the error.
-
-    Returns
-    -------
-    (n−2, 3) int64
-        Each triangle in the polygon's own orientation; every vertex is used.
-
-    Raises
-    ------
-    TriangulationError
-        The triangles do not cover exactly the polygon's area, or leave a vertex
-        out (a polygon that is not simple, or degenerate).
-    """
-    return triangulate_polygons([xy], None if face is None else [face])[0]
-
-
-def triangulate_polygons(polygons, faces=None) -> list:
-    """:func:`triangulate_polygon` of many polygons, checked all at once.
-
-    Parameters
-    ----------
-    polygons : sequence of (n_i, 2) float
-        mm.
-    faces : sequence of int, optional
-        The index named in the error of each polygon (default: its position).
-
-    Returns
-    -------
-    list of (n_i − 2, 3) int64, local indices in each polygon's orientation.
-    """
-    local = [np.asarray(xy, dtype=np.float64) for xy in polygons]
-    if not local:
-        return []
-    sizes = np.array([len(xy) for xy in local], dtype=np.int64)
-    faces = np.arange(len(local)) if faces is None else np.asarray(faces)
-    small = np.flatnonzero(sizes < 3)
-    if len(small):
-        raise TriangulationError(_not_simple(faces[small[0]], local[small[0]], (), 0.0))
-    # each polygon relative to its first vertex: small coordinates, exact areas
-    local = [np.ascontiguousarray(xy - xy[0]) for xy in local]
-    tris = [mapbox_earcut.triangulate_float64(xy, np.array([len(xy)], dtype=np.uint32))
-            .reshape(-1, 3).astype(np.int64) for xy in local]
-    flip, bad, covered = _covers(local, sizes, tris)
-    if bad.any():
-        i = int(np.argmax(bad))
-        raise TriangulationError(_not_simple(faces[i], local[i], tris[i], covered[i]))
-    return [t[:, ::-1] if f else t for t, f in zip(tris, flip)]
-
-
-def _covers(local: list, sizes: np.ndarray, tris: list):
-    """Per polygon: whether earcut's triangles need reversing into its orientation, whether
-    they fail to be n−2 of one winding covering its area (relative
-    :data:`AREA_TOLERANCE`), and the area they cover (mm²); (P,) bool, bool, float."""
-    starts = np.concatenate([[0], np.cumsum(sizes)[:-1]])
-    xy = np.vstack(local)
-    count = np.array([len(t) for t in tris], dtype=np.int64)
-    owner = np.repeat(np.arange(len(local)), count)
-    v = xy[np.vstack(tris) + np.repeat(starts, count)[:, None]]
-    ab, ac = v[:, 1] - v[:, 0], v[:, 2] - v[:, 0]
-    twice = ab[:, 0] * ac[:, 1] - ab[:, 1] * ac[:, 0]
-    following = np.arange(len(xy)) + 1
-    following[starts + sizes - 1] = starts               # each polygon closes on itself
-    polygon = np.repeat(np.arange(len(local)), sizes)
-    area2 = np.bincount(polygon, xy[:, 0] * xy[following, 1] - xy[following, 0] * xy[:, 1],
-                        minlength=len(local))
-    flip = np.bincount(owner, twice, minlength=len(local)) * area2 < 0
-    wound = twice * np.where(flip == (area2 >= 0), -1.0, 1.0)[owner]   # > 0 once flipped
-    wrong = np.bincount(owner, wound < 0, minlength=len(local)) > 0
-    covered = 0.5 * np.bincount(owner, np.abs(twice), minlength=len(local))
-    extent = (np.maximum.reduceat(xy, starts) - np.minimum.reduceat(xy, starts)).max(axis=1)
-    area = 0.5 * np.abs(area2)
-    tolerance = AREA_TOLERANCE * (area + sizes * extent ** 2 * 1e-6)
-    bad = (count != sizes - 2) | wrong | ~(np.abs(covered - area) <= tolerance)  # NaN: bad
-    return flip, bad, covered
-
-
-def _not_simple(face, xy: np.ndarray, tris, covered: float) -> str:
-    """The message of a polygon (n, 2) mm whose triangles ``tris`` fail the checks."""
-    n = len(xy)
-    area = abs(_shoelace(xy)) if n >= 3 else 0.0
-    left = np.setdiff1d(np.arange(n), np.asarray(tris, dtype=np.int64).ravel())
-    detail = f"; vertex {int(left[0])} left out" if len(left) else ""
-    return (f"cannot triangulate face {face}: its {n}-vertex polygon of {area:.6g} mm² is "
-            f"not simple ({len(tris)} triangle(s) covering {covered:.6g} mm²{detail})")
-
-
-def _shoelace(xy: np.ndarray) -> float:
-    """Signed area of a polygon (n, 2), counter-clockwise > 0."""
-    x, y = xy[:, 0], xy[:, 1]
-    return 0.5 * float(x @ np.roll(y, -1) - np.roll(x, -1) @ y)
-
+from .triangulation import (AREA_TOLERANCE, TriangulationError, triangulate_polygon,  # noqa: F401
+                            triangulate_polygons)
 
 def surface_triangles(mesh, surface: SurfaceFaces | None = None, return_faces: bool = False,
                       source: str | None = None):

@@ -19,7 +19,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..mesh import prism_face_loops
-from ..surface import triangulate_polygons
+from ..triangulation import triangulate_polygons
 from . import kernels
 
 

@@ -1,0 +1,10 @@
+"""A thin sheet as bars and hinges: Origami Simulator's model, settled by Newton.
+
+``build_sheet(pattern)`` cuts the pattern into triangles and springs
+(:mod:`.build`); ``fold_sheet(sheet, fold_percent)`` finds the sheet's static
+equilibrium (:mod:`.solve`), the shape Origami Simulator's dynamics settle to.
+"""
+from .build import Sheet, Stiffness, build_sheet
+from .solve import SheetFold, fold_sheet
+
+__all__ = ["Sheet", "SheetFold", "Stiffness", "build_sheet", "fold_sheet"]

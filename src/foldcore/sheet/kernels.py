@@ -1,0 +1,196 @@
+"""numba kernels of the bar-and-hinge sheet: energy, gradient and Hessian.
+
+Three element kinds, each with its analytic gradient; the Hessian of an
+element is the central difference of its gradient (exact to ~1e-10 relative
+at these sizes, and one code path instead of three hand-derived second
+derivatives that are easy to get wrong):
+
+* **bar** ``(a, b)``: ``½ k (L − L₀)²``;
+* **hinge** ``(a, b, c, d)``: ``½ k (φ − φ̄)²``, the hinge on ``a → b``, ``c``
+  the tip of the triangle left of it, ``d`` of the one right of it; ``φ`` the
+  fold angle (radians, valley > 0 for a counter-clockwise sheet seen from +z),
+  unwrapped to within π of a reference so a fold past ±180° keeps counting;
+* **triangle** ``(a, b, c)``: ``½ k Σ (α − α₀)²`` over its three corner angles.
+
+Units: the sheet's normalised frame (lengths / its bounding radius), angles in
+radians. All kernels take positions ``x`` (N, 3).
+"""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+from numba import njit, prange
+
+from elements.cache import choose_cache_dir
+
+choose_cache_dir(Path(__file__))  # before this module's cache=True kernels (read-only installs)
+
+STEP = 1e-6  # central-difference step of the Hessians, normalised units
+
+
+@njit(cache=True, inline="always")
+def _sub(x, i, j):
+    return np.array((x[i, 0] - x[j, 0], x[i, 1] - x[j, 1], x[i, 2] - x[j, 2]))
+
+
+@njit(cache=True, inline="always")
+def _cross(u, v):
+    return np.array((u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2],
+                     u[0] * v[1] - u[1] * v[0]))
+
+
+@njit(cache=True, inline="always")
+def _dot(u, v):
+    return u[0] * v[0] + u[1] * v[1] + u[2] * v[2]
+
+
+@njit(cache=True)
+def fold_angle(p, reference):
+    """Fold angle (radians) of hinge points ``p`` (4, 3) = (a, b, c, d), the value
+    of ``atan2`` plus the multiple of 2π nearest ``reference``."""
+    e = p[1] - p[0]
+    m = _cross(p[2] - p[0], e)   # normal of the left triangle (c side), length 2 A₁
+    n = _cross(e, p[3] - p[0])   # normal of the right triangle (d side)
+    le = math.sqrt(_dot(e, e))
+    phi = math.atan2(_dot(_cross(n, m), e) / le, _dot(m, n))
+    return phi + 2.0 * math.pi * round((reference - phi) / (2.0 * math.pi))
+
+
+@njit(cache=True)
+def fold_angle_gradient(p, g):
+    """∂φ/∂p of hinge points ``p`` (4, 3) into ``g`` (4, 3); False when a triangle
+    is degenerate (g left zero)."""
+    e = p[1] - p[0]
+    ee = _dot(e, e)
+    m = _cross(p[2] - p[0], e)
+    n = _cross(e, p[3] - p[0])
+    mm, nn = _dot(m, m), _dot(n, n)
+    g[:] = 0.0
+    if ee <= 0.0 or mm <= 1e-30 * ee * ee or nn <= 1e-30 * ee * ee:
+        return False
+    le = math.sqrt(ee)
+    gc = -le / mm * m
+    gd = -le / nn * n
+    sc = _dot(p[2] - p[0], e) / ee
+    sd = _dot(p[3] - p[0], e) / ee
+    g[2] = gc
+    g[3] = gd
+    g[0] = -(1.0 - sc) * gc - (1.0 - sd) * gd
+    g[1] = -sc * gc - sd * gd
+    return True
+
+
+@njit(cache=True)
+def _bar_gradient(p, k, rest, g):
+    d = p[1] - p[0]
+    length = math.sqrt(_dot(d, d))
+    if length <= 0.0:
+        g[:] = 0.0
+        return 0.0
+    f = k * (length - rest) / length
+    g[0] = -f * d
+    g[1] = f * d
+    return 0.5 * k * (length - rest) ** 2
+
+
+@njit(cache=True)
+def _hinge_gradient(p, k, target, reference, g):
+    phi = fold_angle(p, reference)
+    fold_angle_gradient(p, g)
+    g *= k * (phi - target)
+    return 0.5 * k * (phi - target) ** 2
+
+
+@njit(cache=True)
+def _corner(p, i, j, l, k, rest, g):
+    """Add ½ k (α − rest)² of the corner at p[i] (between p[j], p[l]) and its
+    gradient into g; returns the energy."""
+    u = p[j] - p[i]
+    v = p[l] - p[i]
+    n = _cross(u, v)
+    s = math.sqrt(_dot(n, n))
+    uu, vv = _dot(u, u), _dot(v, v)
+    if s <= 1e-30 * (uu + vv) or uu <= 0.0 or vv <= 0.0:
+        return 0.0
+    alpha = math.atan2(s, _dot(u, v))
+    n = n / s
+    gj = -_cross(n, u) / uu
+    gl = _cross(n, v) / vv
+    f = k * (alpha - rest)
+    g[j] += f * gj
+    g[l] += f * gl
+    g[i] -= f * (gj + gl)
+    return 0.5 * k * (alpha - rest) ** 2
+
+
+@njit(cache=True)
+def _triangle_gradient(p, k, rest, g):
+    g[:] = 0.0
+    return (_corner(p, 0, 1, 2, k, rest[0], g) + _corner(p, 1, 2, 0, k, rest[1], g)
+            + _corner(p, 2, 0, 1, k, rest[2], g))
+
+
+@njit(cache=True)
+def _element_gradient(kind, p, k, rest, reference, g):
+    """Energy and gradient (into g) of one element of ``kind`` 0 bar, 1 hinge,
+    2 triangle at its points ``p``."""
+    if kind == 0:
+        return _bar_gradient(p, k, rest[0], g)
+    if kind == 1:
+        return _hinge_gradient(p, k, rest[0], reference, g)
+    return _triangle_gradient(p, k, rest, g)
+
+
+@njit(cache=True, parallel=True)
+def evaluate(x, nodes, sizes, kinds, stiffness, rest, reference, energy, gradient, hessian,
+             want_hessian):
+    """Every element's energy, gradient and (``want_hessian``) Hessian.
+
+    Parameters
+    ----------
+    x : (N, 3) float, positions
+    nodes : (M, 4) int, each element's nodes (the first ``sizes[e]`` used)
+    sizes, kinds : (M,) int, node count and kind (0 bar, 1 hinge, 2 triangle)
+    stiffness : (M,) float
+    rest : (M, 3) float, rest length / target angle / rest corner angles
+    reference : (M,) float, each hinge's unwrapping reference angle
+    energy : (M,) float, out
+    gradient : (M, 12) float, out: ∂E/∂(node coordinates), node-major
+    hessian : (M, 12, 12) float, out when ``want_hessian``
+    """
+    for e in prange(len(kinds)):
+        size = sizes[e]
+        p = np.empty((size, 3))
+        for a in range(size):
+            p[a] = x[nodes[e, a]]
+        g = np.zeros((size, 3))
+        energy[e] = _element_gradient(kinds[e], p, stiffness[e], rest[e], reference[e], g)
+        gradient[e, :3 * size] = g.ravel()
+        if not want_hessian:
+            continue
+        gp = np.zeros((size, 3))
+        gm = np.zeros((size, 3))
+        for a in range(size):
+            for c in range(3):
+                keep = p[a, c]
+                p[a, c] = keep + STEP
+                _element_gradient(kinds[e], p, stiffness[e], rest[e], reference[e], gp)
+                p[a, c] = keep - STEP
+                _element_gradient(kinds[e], p, stiffness[e], rest[e], reference[e], gm)
+                p[a, c] = keep
+                column = 3 * a + c
+                hessian[e, :3 * size, column] = (gp.ravel() - gm.ravel()) / (2.0 * STEP)
+        h = hessian[e, :3 * size, :3 * size]
+        hessian[e, :3 * size, :3 * size] = 0.5 * (h + h.T)
+
+
+@njit(cache=True, parallel=True)
+def fold_angles(x, hinges, reference, out):
+    """Fold angle (radians) of every hinge (H, 4) at x, unwrapped near ``reference``."""
+    for h in prange(len(hinges)):
+        p = np.empty((4, 3))
+        for a in range(4):
+            p[a] = x[hinges[h, a]]
+        out[h] = fold_angle(p, reference[h])

@@ -1,0 +1,238 @@
+"""The static equilibrium of a :class:`~.build.Sheet` at a fold percent, by Newton's method.
+
+Origami Simulator reaches its shape by damped dynamics, thousands of explicit
+steps; the shape it settles to is a minimum of the sheet's energy, which
+Newton's method reaches in tens of steps. Each step solves
+``(H + μ I) Δx = −g`` (H the sparse Hessian, a CHOLMOD factor reused
+symbolically from step to step), with a backtracking line search on the
+energy. μ (Levenberg–Marquardt) keeps the matrix positive definite away from
+the minimum (the Hessian of a hinge far from its target is indefinite) and
+fixes the six rigid motions, which the energy does not see; it shrinks as
+steps succeed, so the last steps are Newton's, quadratically convergent.
+"""
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+
+from ..linsolve import Factor, not_positive_definite
+from .build import HINGE, Sheet
+from .kernels import evaluate, fold_angles
+
+TOLERANCE = 1e-9       # largest force at equilibrium, normalised units (module docstring)
+MAX_ITERATIONS = 500
+MU_START, MU_FLOOR, MU_CEILING = 1e-3, 1e-9, 1e12
+ARMIJO, HALVINGS = 1e-4, 40
+ROUNDOFF = 1e-13  # energy changes below this share of the energy are rounding
+
+
+@dataclass
+class SheetFold:
+    """A settled (or not) thin sheet.
+
+    Attributes
+    ----------
+    positions : (N, 3) float, mm
+    fold_angles_deg : (E,) float, each pattern edge's fold angle, degrees,
+        valley > 0; NaN on the boundary
+    hinge_angles : (H,) float, radians, every hinge of the sheet (facets included)
+    iterations : int, Newton steps taken
+    converged : bool, the largest force fell below the tolerance
+    reason : str, ``"converged"``, ``"stalled"`` (no step lowers the energy) or ``"budget"``
+    residual : float, the largest force at the end, normalised units
+    energy : float, normalised units
+    seconds : float, wall time of the solve
+    """
+
+    positions: np.ndarray
+    fold_angles_deg: np.ndarray
+    hinge_angles: np.ndarray
+    iterations: int
+    converged: bool
+    reason: str
+    residual: float
+    energy: float
+    seconds: float
+
+
+class Assembly:
+    """Where each element's gradient and Hessian entries go in the global ones."""
+
+    def __init__(self, sheet: Sheet):
+        n = 3 * len(sheet.flat)
+        sizes = sheet.sizes
+        dofs = np.full((len(sizes), 12), -1, dtype=np.int64)
+        for a in range(4):
+            used = sizes > a
+            for c in range(3):
+                dofs[used, 3 * a + c] = 3 * sheet.nodes[used, a] + c
+        self.n = n
+        self.gradient_rows = dofs[dofs >= 0]
+        self.gradient_take = np.flatnonzero((dofs >= 0).ravel())
+        pair = (dofs[:, :, None] >= 0) & (dofs[:, None, :] >= 0)
+        rows = np.broadcast_to(dofs[:, :, None], pair.shape)[pair]
+        cols = np.broadcast_to(dofs[:, None, :], pair.shape)[pair]
+        self.hessian_take = np.flatnonzero(pair.ravel())
+        keys, self.slot = np.unique(cols * n + rows, return_inverse=True)
+        self.indices = keys % n
+        self.indptr = np.searchsorted(keys // n, np.arange(n + 1))
+        self.diagonal = np.flatnonzero(self.indices == np.repeat(np.arange(n),
+                                                                 np.diff(self.indptr)))
+
+    def gradient(self, element_gradients: np.ndarray) -> np.ndarray:
+        """(3N,) global gradient of (M, 12) element gradients."""
+        values = element_gradients.ravel()[self.gradient_take]
+        return np.bincount(self.gradient_rows, weights=values, minlength=self.n)
+
+    def hessian_values(self, element_hessians: np.ndarray) -> np.ndarray:
+        """CSC data of the global Hessian of (M, 12, 12) element Hessians."""
+        values = element_hessians.ravel()[self.hessian_take]
+        return np.bincount(self.slot, weights=values, minlength=len(self.indices))
+
+    def matrix(self, data: np.ndarray) -> sp.csc_matrix:
+        return sp.csc_matrix((data, self.indices, self.indptr), shape=(self.n, self.n))
+
+
+class Energy:
+    """The sheet's energy at one fold percent, with its gradient and Hessian."""
+
+    def __init__(self, sheet: Sheet, fold_percent: float):
+        self.sheet = sheet
+        self.rest = sheet.rest.copy()
+        self.is_hinge = sheet.kinds == HINGE
+        self.rest[self.is_hinge, 0] *= fold_percent / 100.0
+        self.reference = np.zeros(len(sheet.kinds))
+        m = len(sheet.kinds)
+        self.energies = np.empty(m)
+        self.gradients = np.zeros((m, 12))
+        self.hessians = np.zeros((m, 12, 12))
+
+    def __call__(self, x: np.ndarray, want_hessian: bool = False) -> float:
+        s = self.sheet
+        evaluate(x, s.nodes, s.sizes, s.kinds, s.stiffness, self.rest, self.reference,
+                 self.energies, self.gradients, self.hessians, want_hessian)
+        return float(self.energies.sum())
+
+    def settle_references(self, x: np.ndarray) -> None:
+        """Unwrap every hinge's angle from here on near its angle at x."""
+        s = self.sheet
+        hinge_nodes = s.nodes[self.is_hinge]
+        out = np.empty(len(hinge_nodes))
+        fold_angles(x, hinge_nodes, self.reference[self.is_hinge], out)
+        self.reference[self.is_hinge] = out
+
+
+def fold_sheet(sheet: Sheet, fold_percent: float = 100.0, start: np.ndarray | None = None,
+               tolerance: float = TOLERANCE, max_iterations: int = MAX_ITERATIONS,
+               backend: str = "auto", pattern_edges: int | None = None) -> SheetFold:
+    """Settle ``sheet`` at ``fold_percent`` (of every crease's target), from flat
+    or from ``start`` (N, 3) mm; see the module docstring.
+
+    ``pattern_edges``: the pattern's edge count, for ``fold_angles_deg``
+    (default: the largest edge id the sheet uses + 1).
+    """
+    t0 = time.perf_counter()
+    energy = Energy(sheet, fold_percent)
+    assembly = Assembly(sheet)
+    x = sheet.flat.copy() if start is None else _normalised(sheet, start)
+    energy.settle_references(x)
+    mu, factor, reason, iterations = MU_START, None, "budget", 0
+    value = energy(x, want_hessian=True)
+    gradient = assembly.gradient(energy.gradients)
+    for iterations in range(max_iterations):
+        if np.max(np.abs(gradient)) < tolerance:
+            reason = "converged"
+            break
+        data = assembly.hessian_values(energy.hessians)
+        scale = max(float(np.max(data[assembly.diagonal])), 1e-300)
+        step, factor, mu = _regularised_step(assembly, data, gradient, mu, scale, factor,
+                                             backend)
+        if step is None:
+            reason = "stalled"
+            break
+        moved, value, full = _line_search(energy, x, value, gradient, step)
+        if moved is None:
+            mu = min(mu * 10.0, MU_CEILING)
+            if mu >= MU_CEILING:
+                reason = "stalled"
+                break
+            continue
+        x = moved
+        energy.settle_references(x)
+        mu = max(mu / 3.0, MU_FLOOR) if full else min(mu * 4.0, MU_CEILING)
+        value = energy(x, want_hessian=True)
+        gradient = assembly.gradient(energy.gradients)
+    else:
+        iterations = max_iterations
+    return _fold(sheet, energy, x, iterations, reason, float(np.max(np.abs(gradient))), value,
+                 time.perf_counter() - t0, pattern_edges)
+
+
+def _normalised(sheet: Sheet, positions_mm: np.ndarray) -> np.ndarray:
+    x = np.array(positions_mm, dtype=float) / sheet.radius
+    x[:, :2] -= sheet.centre / sheet.radius
+    return x
+
+
+def _regularised_step(assembly: Assembly, data, gradient, mu, scale, factor, backend):
+    """(step, factor, μ): the solution of (H + μ·scale·I) Δ = −g, raising μ until the
+    matrix factors; (None, factor, μ) when it never does."""
+    while mu < MU_CEILING:
+        shifted = data.copy()
+        shifted[assembly.diagonal] += mu * scale
+        matrix = assembly.matrix(shifted)
+        try:
+            if factor is None:
+                factor = Factor(matrix, backend)
+            else:
+                factor.refactor(matrix)
+            step = -factor.solve(gradient)
+            if np.all(np.isfinite(step)):
+                return step, factor, mu
+        except not_positive_definite():
+            factor = None
+        mu *= 10.0
+    return None, factor, mu
+
+
+def _line_search(energy: Energy, x, value, gradient, step):
+    """(x + t·step, its energy, t == 1) for the largest t = 2⁻ᵏ meeting Armijo's
+    condition; (None, value, False) when none does."""
+    slope = float(gradient @ step)
+    if slope >= 0.0:
+        return None, value, False
+    t = 1.0
+    flat_step = step.reshape(-1, 3)
+    for _ in range(HALVINGS):
+        trial = x + t * flat_step
+        trial_value = energy(trial)
+        if trial_value <= value + ARMIJO * t * slope:
+            return trial, trial_value, t == 1.0
+        if trial_value - value <= ROUNDOFF * abs(value) and t == 1.0:
+            return trial, trial_value, True  # a change below the energy's rounding
+        t *= 0.5
+    return None, value, False
+
+
+def _fold(sheet: Sheet, energy: Energy, x, iterations, reason, residual, value, seconds,
+          pattern_edges) -> SheetFold:
+    angles = np.empty(len(sheet.hinges))
+    fold_angles(x, sheet.hinges, _hinge_references(sheet, energy), angles)
+    count = pattern_edges if pattern_edges is not None else int(sheet.hinge_edge.max()) + 1
+    per_edge = np.full(count, math.nan)
+    named = sheet.hinge_edge >= 0
+    per_edge[sheet.hinge_edge[named]] = np.degrees(angles[named])
+    return SheetFold(sheet.to_mm(x), per_edge, angles, iterations, reason == "converged",
+                     reason, residual, value, seconds)
+
+
+def _hinge_references(sheet: Sheet, energy: Energy) -> np.ndarray:
+    """Per hinge of the sheet, the unwrapping reference (0 for unsprung hinges)."""
+    out = np.zeros(len(sheet.hinges))
+    sprung = sheet.hinge_elements >= 0
+    out[sprung] = energy.reference[sheet.hinge_elements[sprung]]
+    return out

@@ -1,0 +1,140 @@
+"""The thin bar-and-hinge sheet (:mod:`foldcore.sheet`): kernels, build, equilibrium.
+
+Ground truth: finite differences for the kernels; zero-thickness closed forms
+(:mod:`foldcore.kinematics`) where the targets are rigidly compatible (then the
+energy's minimum is zero and every crease meets its target exactly).
+"""
+import numpy as np
+import pytest
+
+from foldcore import kinematics, patterns
+from foldcore.sheet import Stiffness, build_sheet, fold_sheet
+from foldcore.sheet import kernels
+from foldcore.sheet.build import BAR, HINGE, TRIANGLE
+
+# Newton's last steps end with forces ~1e-9 (normalised units): the angles then
+# carry errors of that order in radians, far below this (degrees).
+EXACT_DEG = 1e-6
+
+
+def _element(kind, size, rng):
+    p = rng.normal(size=(size, 3))
+    nodes = np.zeros((1, 4), dtype=np.int64)
+    nodes[0, :size] = np.arange(size)
+    rest = np.array([[0.9, 1.0, 1.1]]) if kind == TRIANGLE else np.array([[0.7, 0.0, 0.0]])
+    reference = np.array([kernels.fold_angle(p, 0.0) if kind == HINGE else 0.0])
+    return p, nodes, rest, reference
+
+
+def _evaluate(kind, size, p, nodes, rest, reference, hessian=False):
+    energy, gradient, hess = np.empty(1), np.zeros((1, 12)), np.zeros((1, 12, 12))
+    kernels.evaluate(p, nodes, np.array([size]), np.array([kind]), np.array([1.3]), rest,
+                     reference, energy, gradient, hess, hessian)
+    return energy[0], gradient[0, :3 * size], hess[0, :3 * size, :3 * size]
+
+
+@pytest.mark.parametrize("kind,size", [(BAR, 2), (HINGE, 4), (TRIANGLE, 3)])
+def test_gradient_and_hessian_match_finite_differences(kind, size):
+    rng = np.random.default_rng(kind)
+    for _ in range(5):
+        p, nodes, rest, reference = _element(kind, size, rng)
+        _, gradient, hessian = _evaluate(kind, size, p, nodes, rest, reference, True)
+        h = 1e-6
+        fd_g, fd_h = np.zeros(3 * size), np.zeros((3 * size, 3 * size))
+        for i in range(3 * size):
+            plus, minus = p.copy(), p.copy()
+            plus.ravel()[i] += h
+            minus.ravel()[i] -= h
+            e_plus, g_plus, _ = _evaluate(kind, size, plus, nodes, rest, reference)
+            e_minus, g_minus, _ = _evaluate(kind, size, minus, nodes, rest, reference)
+            fd_g[i] = (e_plus - e_minus) / (2 * h)
+            fd_h[:, i] = (g_plus - g_minus) / (2 * h)
+        # central differences at h = 1e-6 on O(1) values: error ~1e-9 relative
+        assert np.max(np.abs(gradient - fd_g)) <= 1e-7 * np.max(np.abs(fd_g))
+        assert np.max(np.abs(hessian - fd_h)) <= 1e-6 * np.max(np.abs(fd_h))
+        assert np.array_equal(hessian, hessian.T)
+
+
+def test_fold_angle_is_valley_positive_and_unwraps():
+    # c left of a → b (counter-clockwise triangle), d lifted towards +z: a valley
+    for angle in (0.3, 2.9, -1.2):
+        p = np.array([[0, 0, 0], [1, 0, 0], [0.5, 1, 0],
+                      [0.5, -np.cos(angle), np.sin(angle)]], dtype=float)
+        assert kernels.fold_angle(p, 0.0) == pytest.approx(angle, abs=1e-12)
+    past = np.array([[0, 0, 0], [1, 0, 0], [0.5, 1, 0], [0.5, 0.9, -0.1]], dtype=float)  # d through c: past 180°
+    assert kernels.fold_angle(past, 3.0) > np.pi  # unwrapped near 3.0, not atan2's −174°
+    assert kernels.fold_angle(past, 0.0) < 0.0
+
+
+def test_sheet_of_a_miura_cuts_each_parallelogram_along_its_shorter_diagonal():
+    pattern = patterns.miura(2, 2, gamma=60.0)
+    sheet = build_sheet(pattern)
+    assert len(sheet.triangles) == 8
+    diagonals = sheet.hinges[sheet.hinge_edge < 0]
+    assert len(diagonals) == 4
+    xy = np.asarray(pattern.vertices)
+    for a, b, c, d in diagonals:
+        other = np.linalg.norm(xy[c] - xy[d])
+        assert np.linalg.norm(xy[a] - xy[b]) <= other
+    # every interior crease is a sprung hinge at its target; the boundary is not
+    interior = np.flatnonzero(np.asarray(pattern.assignments) != "B")
+    assert set(sheet.hinge_edge[sheet.hinge_edge >= 0]) == set(interior)
+    assert sheet.radius == pytest.approx(np.max(np.linalg.norm(
+        xy - 0.5 * (xy.min(0) + xy.max(0)), axis=1)))
+
+
+def _miura_at(tilt, n=3, m=3, gamma=60.0):
+    angles = patterns.miura_fold_angles(n, m, gamma, tilt)
+    return patterns.miura(n, m, gamma=gamma).replace(fold_angles=angles), angles
+
+
+@pytest.mark.parametrize("tilt,percent", [(30.0, 100.0), (60.0, 100.0), (60.0, 50.0)])
+def test_rigidly_compatible_miura_meets_every_target(tilt, percent):
+    pattern, angles = _miura_at(tilt)
+    fold = fold_sheet(build_sheet(pattern), percent, pattern_edges=len(pattern.edges))
+    assert fold.converged
+    interior = ~np.isnan(angles)
+    if percent == 100.0:
+        assert np.max(np.abs(fold.fold_angles_deg[interior] - angles[interior])) < EXACT_DEG
+        assert fold.energy < 1e-16
+    else:  # half of every target is not rigidly compatible: the facets bend
+        assert fold.energy > 0
+        assert np.all(np.sign(fold.fold_angles_deg[interior]) == np.sign(angles[interior]))
+
+
+def test_degree4_vertex_meets_its_closed_form():
+    sectors = (135.0, 90.0, 45.0, 90.0)
+    rho = kinematics.degree4_deg(sectors[0], sectors[1], 100.0, "A")
+    pattern = patterns.single_vertex(sectors, patterns.degree4_assignments(sectors, "A"),
+                                     fold_angles=rho)
+    fold = fold_sheet(build_sheet(pattern), 100.0, pattern_edges=len(pattern.edges))
+    creases = np.flatnonzero(np.asarray(pattern.assignments) != "B")
+    assert fold.converged
+    assert np.max(np.abs(fold.fold_angles_deg[creases] - rho)) < EXACT_DEG
+
+
+def test_shape_does_not_depend_on_the_unit():
+    pattern, _ = _miura_at(45.0)
+    half = pattern.replace(fold_angles=np.asarray(pattern.fold_angles) * 0.7)
+    micro = half.replace(vertices=np.asarray(half.vertices) * 1000.0)
+    mm = fold_sheet(build_sheet(half), 80.0, pattern_edges=len(half.edges))
+    um = fold_sheet(build_sheet(micro), 80.0, pattern_edges=len(half.edges))
+    assert mm.iterations == um.iterations
+    assert np.allclose(mm.fold_angles_deg, um.fold_angles_deg, atol=EXACT_DEG, equal_nan=True)
+    assert np.allclose(um.positions, 1000.0 * mm.positions, atol=1e-6 * 1000.0 * 60)
+
+
+def test_flat_at_zero_percent_and_stiffer_creases_meet_targets_closer():
+    pattern, angles = _miura_at(50.0)
+    sheet = build_sheet(pattern.replace(fold_angles=np.asarray(pattern.fold_angles) * 0.6))
+    flat = fold_sheet(sheet, 0.0)
+    assert flat.iterations == 0 and flat.converged
+    soft = fold_sheet(sheet, 100.0, pattern_edges=len(pattern.edges))
+    stiff_sheet = build_sheet(pattern.replace(fold_angles=np.asarray(pattern.fold_angles) * 0.6),
+                              Stiffness(crease=7.0))
+    stiff = fold_sheet(stiff_sheet, 100.0, pattern_edges=len(pattern.edges))
+    target = 0.6 * angles
+    interior = ~np.isnan(angles)
+    miss = [np.max(np.abs(f.fold_angles_deg[interior] - target[interior])) for f in (soft, stiff)]
+    assert soft.converged and stiff.converged
+    assert miss[1] < miss[0]
