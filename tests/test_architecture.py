@@ -161,10 +161,10 @@ def test_the_import_graph_has_no_cycle():
 LAYERS = [
     ("foldcore.cli", "foldcore.demo", "foldcore.warmup", "foldcore.__main__",
      "foldcore.interrupts"),
-    ("foldcore.job", "foldcore.scenes"),
+    ("foldcore.job", "foldcore.scenes", "foldcore.sheet_job"),
     ("foldcore.animate", "foldcore.view", "foldcore.outputs", "foldcore.render",
      "foldcore.fabrication", "foldcore.destinations", "foldcore.result_file",
-     "foldcore.surface"),
+     "foldcore.surface", "foldcore.sheet_outputs", "foldcore.sheet_render"),
     ("foldcore.simulation", "foldcore.result"),
     ("foldcore.strategies",),
     ("foldcore.convergence", "foldcore.probe", "foldcore.certificate"),

@@ -145,14 +145,17 @@ def test_malformed_file_exits_2_with_one_line_and_no_output(kind, fold_file, tmp
     assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")]  # no temp files
 
 
-def test_missing_file_and_missing_thickness_exit_2(tmp_path, capsys):
+def test_missing_file_exits_2_and_missing_thickness_folds_a_thin_sheet(tmp_path, capsys):
     assert main(["simulate", str(tmp_path / "nope.fold")]) == 2
     assert "nope.fold" in capsys.readouterr().err
     pattern = patterns.single_hinge(angle=30.0, width=2.0)
-    path = tmp_path / "thin.fold"
+    path, report = tmp_path / "thin.fold", tmp_path / "thin.json"
     write_fold(path, pattern)                       # no foldcore:thickness
-    assert main(["simulate", str(path)]) == 2
-    assert "--thickness" in capsys.readouterr().err
+    assert main(["simulate", str(path), "--report", str(report)]) == 0
+    err = capsys.readouterr().err
+    assert "folded as a thin sheet" in err and "--thickness" in err
+    hinge = json.loads(report.read_text())["fold_angles_deg"][0]
+    assert hinge == pytest.approx(30.0, abs=1e-6)   # one spring, nothing resists it
 
 
 def test_bad_option_values_exit_2(fold_file, capsys):

@@ -250,5 +250,5 @@ def test_a_crease_folded_to_the_other_side_is_counted_and_said():
         _, said = run_summary(result, pattern, "hinge.fold", 100)
         assert len(said) == 1 and ("1 folded to the other side" in said[0]) == bool(wrong)
         assert "thickening.elastic_cells lets the panels bend" in said[0]
-    _, said = run_summary(result, pattern, "hinge.fold", 100, elastic=True)
+    _, said = run_summary(result, pattern, "hinge.fold", 100, model="elastic")
     assert "with elastic panels" in said[0] and "elastic_cells" not in said[0]

@@ -123,7 +123,10 @@ def fold(path, *, hinges=None, reading=None, thickening=None, solving=None, outp
     from .outputs import run_summary, write_result
 
     job = Job.make(path, hinges, reading, thickening, solving, outputs)
-    loaded, thickness, mesh, sim = prepare(job)
+    loaded, thickness = _prepared(job)
+    if thickness is None:
+        return _fold_thin(job, loaded, on_start, callback)
+    mesh, sim = _simulation(job, loaded, thickness)
     if on_start is not None:
         on_start()
     out, s = job.outputs, job.solving
@@ -142,7 +145,7 @@ def fold(path, *, hinges=None, reading=None, thickening=None, solving=None, outp
         except KeyboardInterrupt:  # the last complete iterate is a result too
             result, interrupted = sim.result(False, "interrupted"), True
     summary, said = run_summary(result, loaded.pattern, job.source, s.fold_percent,
-                                elastic=bool(mesh.elastic))
+                                model="elastic" if mesh.elastic else "rigid")
     for text in said:
         warnings.warn(text, RunWarning, stacklevel=3)
     settings = run_settings(job, thickness, mesh, sim)
@@ -151,10 +154,28 @@ def fold(path, *, hinges=None, reading=None, thickening=None, solving=None, outp
                      report=out.report, png=out.render, partial=interrupted,
                      series=out.series, sweep=sweep)
     if interrupted or late:
-        written = {k: v for k, v in out.paths().items() if v and k in
-                   ("outputs.fold", "outputs.report", "outputs.render", "outputs.series")}
-        raise Interrupted(result, written, partial=interrupted)
+        raise Interrupted(result, _written(out), partial=interrupted)
     return Fold(loaded.pattern, mesh, sim, result, settings, summary)
+
+
+def _fold_thin(job, loaded, on_start, callback) -> Fold:
+    """:func:`fold` of a pattern with no thickness: a thin sheet (:mod:`foldcore.sheet_job`)."""
+    from .sheet_job import check_thin, run_thin, thin_settings, thin_summary, write_thin
+
+    check_thin(job)
+    sheet, solver, result, interrupted = run_thin(job, loaded, on_start, callback)
+    summary = thin_summary(job, loaded.pattern, result)
+    with interrupts_deferred() as late:
+        write_thin(job, loaded.pattern, sheet, result, interrupted)
+    if interrupted or late:
+        raise Interrupted(result, _written(job.outputs), partial=interrupted)
+    return Fold(loaded.pattern, sheet, solver, result, thin_settings(job), summary)
+
+
+def _written(out) -> dict:
+    """``outputs.field`` → path of the outputs asked for that a run writes."""
+    return {k: v for k, v in out.paths().items() if v and k in
+            ("outputs.fold", "outputs.report", "outputs.render", "outputs.series")}
 
 
 @contextmanager
@@ -189,6 +210,9 @@ def prepare(job: Job) -> tuple:
     its thickness (mm), the thick mesh and its :class:`foldcore.Simulation` at the flat
     state; everything that can fail on the inputs fails before the mesh is built."""
     loaded, thickness = _prepared(job)
+    if thickness is None:
+        raise OptionError(f"{job.source}: no thickness: give thickening.thickness (mm) "
+                          "or set foldcore:thickness in the file")
     return (loaded, thickness, *_simulation(job, loaded, thickness))
 
 
@@ -205,11 +229,8 @@ def _prepared(job: Job):
     check_inputs(loaded.pattern, t.thickness, t.hinge_width, loaded.stiffness,
                  t.elastic_cells, job.solving.ground)
     thickness = t.thickness or loaded.thickness
-    if thickness is None:
-        raise OptionError(f"{job.source}: no thickness: give thickening.thickness (mm) "
-                          "or set foldcore:thickness in the file")
     ground = job.solving.ground
-    if ground is not None and not ground < -0.5 * thickness:
+    if ground is not None and thickness is not None and not ground < -0.5 * thickness:
         raise OptionError(f"{job.source}: solving.ground = {ground:g} mm is not below the "
                           f"flat sheet, whose bottom face is at z = {-0.5 * thickness:g} mm "
                           "(the ground faces up and holds the sheet from below)")

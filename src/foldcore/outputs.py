@@ -95,14 +95,22 @@ def _iteration_cost(result) -> dict:
 #: Degrees by which a converged run's driven creases may miss their targets before it
 #: is said to bind (its targets unreachable in this model) rather than to have folded.
 MISS_WARNING_DEG = 1.0
+#: Why targets bind, per model (:func:`run_summary`).
+BINDING = {"rigid": "(with rigid panels: a pattern that is not rigidly foldable; "
+                    "thickening.elastic_cells lets the panels bend)",
+           "elastic": "(with elastic panels: meeting them needs the faces to stretch, or "
+                      "hinge stiffness factors above the panels')",
+           "sheet": "(in a thin sheet the creases are springs that the facets' bending "
+                    "resists: a pattern that is not rigidly foldable, or targets that "
+                    "are not compatible at this fold percent)"}
 
 
 def run_summary(result, pattern, source: str, fold_percent: float,
-                elastic: bool = False) -> tuple[str, list[str]]:
+                model: str = "rigid") -> tuple[str, list[str]]:
     """The one-line summary of a run (verdict, iterations, time, the driven creases'
     miss) and the warnings it calls for: nothing driven, or converged with targets
-    missed by more than :data:`MISS_WARNING_DEG` (``elastic``: the mesh has elastic
-    panels, so the warning does not suggest them)."""
+    missed by more than :data:`MISS_WARNING_DEG`, saying why in the terms of the
+    ``model`` (:data:`BINDING`: ``rigid`` or ``elastic`` panels, thin ``sheet``)."""
     entries = actuation_entries(result, pattern)
     driven, worst = len(entries["creases"]), entries["largest_miss_deg"]
     verdict = "converged" if result.converged else f"not converged ({result.reason})"
@@ -140,11 +148,7 @@ def run_summary(result, pattern, source: str, fold_percent: float,
                      f"their targets by more than {MISS_WARNING_DEG:g}° (up to {worst:.3g}°"
                      + (f"; {wrong} folded to the other side" if wrong else "") + "): "
                      "the model binds there — these targets cannot all be met at once "
-                     + ("(with elastic panels: meeting them needs the faces to stretch, or "
-                        "hinge stiffness factors above the panels')" if elastic else
-                        "(with rigid panels: a pattern that is not rigidly foldable; "
-                        "thickening.elastic_cells lets the panels bend)")
-                     + "; the report's actuation lists each crease "
+                     + BINDING[model] + "; the report's actuation lists each crease "
                      "(docs/guide/strategies.md#reached-or-binding)")
     return line, warns
 
@@ -216,10 +220,6 @@ def report_dict(result, pattern, mesh, settings: dict, quantities: dict | None =
     Angles in degrees (valley > 0), lengths mm, times seconds. ``quantities``
     (a scene's own measurements) go under the key ``quantities``.
     """
-    import numba
-
-    from .linsolve import cholmod_available
-
     energy = result.energy
     return {
         "iterations": int(result.iterations),
@@ -247,10 +247,18 @@ def report_dict(result, pattern, mesh, settings: dict, quantities: dict | None =
         **_iteration_cost(result),
         "settings": settings,
         **({"quantities": quantities} if quantities else {}),
-        "machine": {"python": platform.python_version(), "numba": numba.__version__,
-                    "numba_threads": numba.get_num_threads(),
-                    "cholmod": cholmod_available()},
+        "machine": machine_entries(),
     }
+
+
+def machine_entries() -> dict:
+    """What a report records of the software that ran it."""
+    import numba
+
+    from .linsolve import cholmod_available
+
+    return {"python": platform.python_version(), "numba": numba.__version__,
+            "numba_threads": numba.get_num_threads(), "cholmod": cholmod_available()}
 
 
 def write_report(path, report: dict) -> None:
@@ -343,24 +351,30 @@ def write_result(result, pattern, mesh, thickness: float, settings: dict, *, fol
                                                        quantities),
                                          **({"partial": True} if partial else {})})
     if png:
-        _write_picture(png, pattern, mesh, result, picture,
-                       written=[p for p in (fold, report, series) if p])
+        write_picture(png, lambda path: _picture(path, pattern, mesh, result, picture),
+                      written=[p for p in (fold, report, series) if p])
 
 
-def _write_picture(png, pattern, mesh, result, picture, written: list) -> None:
-    """The PNG (``picture``, or a render of ``result``), atomically, after the data
-    files; an OutputError naming it, and the files already written, if it fails
-    (a run's result is not lost to its picture)."""
-    from .files import OutputError, atomic_path
+def _picture(png, pattern, mesh, result, picture) -> None:
+    """``picture`` written as the PNG, or a render of ``result``."""
+    if picture is not None:
+        import imageio.v3 as iio
+
+        from .files import atomic_path
+        with atomic_path(png) as tmp:
+            iio.imwrite(tmp, picture, extension=".png")
+    else:
+        from .render import render_png
+        render_png(pattern, mesh, result.positions, png)
+
+
+def write_picture(png, draw, written: list) -> None:
+    """``draw(png)`` after the data files; an OutputError naming the PNG, and the
+    files already written, if it fails (a run's result is not lost to its picture)."""
+    from .files import OutputError
 
     try:
-        if picture is not None:
-            import imageio.v3 as iio
-            with atomic_path(png) as tmp:
-                iio.imwrite(tmp, picture, extension=".png")
-        else:
-            from .render import render_png
-            render_png(pattern, mesh, result.positions, png)
+        draw(png)
     except Exception as exc:  # whatever the renderer raised: said, the data kept
         reason = " ".join(str(exc).split())[:300] or type(exc).__name__
         raise OutputError(f"{png}: the picture was not written ({reason})"

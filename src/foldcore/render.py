@@ -261,14 +261,14 @@ def _surface_parts(mesh, positions, source: str | None = None):
     return panels, hinges, lines
 
 
-def _behind_lines(actor) -> None:
+def behind_lines(actor) -> None:
     """Push an actor's polygons back in depth so edge lines on them stay visible."""
     mapper = actor.GetMapper()
     mapper.SetResolveCoincidentTopologyToPolygonOffset()
     mapper.SetRelativeCoincidentTopologyPolygonOffsetParameters(2.0, 2.0)
 
 
-def _fit_camera(camera, points, direction, up, aspect, box, padding) -> None:
+def fit_camera(camera, points, direction, up, aspect, box, padding) -> None:
     """Orthographic camera looking along −direction, fitting ``points`` into ``box``.
 
     ``box`` = (x0, x1, y0, y1), the free part of the picture in normalised
@@ -356,7 +356,7 @@ class Renderer:
     # -- scene
     def _add_panels(self):
         if self.panels is not None:
-            _behind_lines(self.plotter.add_mesh(self.panels, color=PANEL_COLOUR))
+            behind_lines(self.plotter.add_mesh(self.panels, color=PANEL_COLOUR))
 
     def _add_edges(self):
         if self.lines is not None:
@@ -368,7 +368,7 @@ class Renderer:
         kinds = np.asarray(self.pattern.assignments)[self.hinges.cell_data["edge"]]
         rgb = np.array([HINGE_COLOURS.get(k, HINGE_COLOURS["U"]) for k in kinds])
         self.hinges.cell_data["colour"] = (255 * rgb).astype(np.uint8)
-        _behind_lines(self.plotter.add_mesh(self.hinges, scalars="colour", rgb=True))
+        behind_lines(self.plotter.add_mesh(self.hinges, scalars="colour", rgb=True))
         present = [k for k in HINGE_COLOURS if k in set(kinds)]
         if legend and present:
             entries = [[HINGE_LABELS[k], HINGE_COLOURS[k]] for k in present]
@@ -392,7 +392,7 @@ class Renderer:
                    position_y=0.03, width=0.6, height=0.09, n_labels=5, fmt="%.3g",
                    title_font_size=self._font(18), label_font_size=self._font(16),
                    unconstrained_font_size=True)
-        _behind_lines(self.plotter.add_mesh(
+        behind_lines(self.plotter.add_mesh(
             self.hinges, scalars="value", cmap=cmap or default_cmap(self.clim), clim=self.clim,
             nan_color=(0.5, 0.5, 0.5), scalar_bar_args=bar))
         self._box[2] = _BAR_STRIP
@@ -438,7 +438,7 @@ class Renderer:
         if points is None:
             points = np.vstack([p.points for p in (self.panels, self.hinges) if p is not None])
         w, h = self.size
-        _fit_camera(self.plotter.camera, points, self.direction, self.up, w / h,
+        fit_camera(self.plotter.camera, points, self.direction, self.up, w / h,
                     self._box, self.padding)
 
     def image(self) -> np.ndarray:

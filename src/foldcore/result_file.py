@@ -26,7 +26,7 @@ import numpy as np
 from . import limits
 from .errors import PatternError
 from .io.fold import edges_poisson, faces_cells, fold_file_from_dict, read_bytes
-from .io.fold_json import (ARRAY, UNIT_MM, check_length, fail, has_class, index, number,
+from .io.fold_json import (ARRAY, MODEL_KEY, UNIT_MM, check_length, fail, has_class, index, number,
                            number_table, parse_json, short)
 
 #: Largest |coordinate| of a folded frame's vertex, mm (after ``frame_unit``): the
@@ -161,6 +161,10 @@ def read_result(path, hinge_width=None, subdivisions=None) -> ResultFile:
     d = parse_json(data, source)
     fold = fold_file_from_dict(d, source)
     frames, faces = _folded_frames(d, fold.pattern.n_edges, source)
+    if fold.thickness is None and d.get(MODEL_KEY) == "sheet":
+        raise PatternError(f"{source}: a thin sheet's result (folded with no thickness): "
+                           "render, view and export read thick results; its folded form "
+                           "is the file's foldedForm frame, for any FOLD viewer")
     if fold.thickness is None:
         raise PatternError(f"{source}: no foldcore:thickness; not a foldcore result file")
     for frame in frames:

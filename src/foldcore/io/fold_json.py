@@ -30,6 +30,7 @@ FACE_STIFFNESS_KEY = "foldcore:faces_stiffness"
 CELLS_KEY = "foldcore:faces_cells"
 POISSON_KEY = "foldcore:edges_poisson"
 HINGE_KEY = "foldcore:edges_hinge"
+MODEL_KEY = "foldcore:model"  # "sheet" in the result of a thin sheet (no thickness)
 #: What a JSON array may be in a FOLD dict: a list, or a tuple from a Python caller.
 ARRAY = (list, tuple)
 #: Digits to "0" and "E" to "e", for :func:`_may_overflow`'s plain substring search.

@@ -5,6 +5,6 @@
 equilibrium (:mod:`.solve`), the shape Origami Simulator's dynamics settle to.
 """
 from .build import Sheet, Stiffness, build_sheet
-from .solve import SheetFold, fold_sheet
+from .solve import SheetFold, SheetSolver, fold_sheet
 
-__all__ = ["Sheet", "SheetFold", "Stiffness", "build_sheet", "fold_sheet"]
+__all__ = ["Sheet", "SheetFold", "SheetSolver", "Stiffness", "build_sheet", "fold_sheet"]

@@ -50,6 +50,7 @@ class Sheet:
     centre : (2,) float, mm, the pattern point at the origin
     radius : float, mm, the pattern's bounding radius (one normalised unit)
     triangles : (T, 3) int, counter-clockwise seen from +z
+    triangle_face : (T,) int, the pattern face each triangle cuts
     hinges : (H, 4) int, (a, b, c, d): the hinge a → b, c left, d right
     hinge_edge : (H,) int, the pattern edge of each hinge, −1 for a diagonal
     targets : (H,) float, radians at 100 %, valley > 0 (0 for facets and passive)
@@ -57,12 +58,14 @@ class Sheet:
         :func:`foldcore.sheet.kernels.evaluate`; hinges are the elements
         ``hinge_elements``
     hinge_elements : (H,) int, element index of each hinge with a spring, −1 without
+    constants : Stiffness, the stiffnesses the elements were made with
     """
 
     flat: np.ndarray
     centre: np.ndarray
     radius: float
     triangles: np.ndarray
+    triangle_face: np.ndarray
     hinges: np.ndarray
     hinge_edge: np.ndarray
     targets: np.ndarray
@@ -72,6 +75,7 @@ class Sheet:
     stiffness: np.ndarray
     rest: np.ndarray
     hinge_elements: np.ndarray
+    constants: Stiffness
 
     def to_mm(self, x: np.ndarray) -> np.ndarray:
         """(N, 3) positions of the normalised frame in the pattern's mm."""
@@ -126,8 +130,9 @@ def build_sheet(pattern: CreasePattern, stiffness: Stiffness = Stiffness()) -> S
     radius = float(np.sqrt(np.max(np.sum((xy - centre) ** 2, axis=1))))
     flat = np.zeros((len(xy), 3))
     flat[:, :2] = (xy - centre) / radius
-    triangles = np.concatenate([face_triangles(xy, np.asarray(loop), f)
-                                for f, loop in enumerate(pattern.faces)])
+    cut = [face_triangles(xy, np.asarray(loop), f) for f, loop in enumerate(pattern.faces)]
+    triangles = np.concatenate(cut)
+    triangle_face = np.repeat(np.arange(len(cut)), [len(t) for t in cut])
     hinges, bars = _hinges(triangles)
     edge_of = {(int(min(a, b)), int(max(a, b))): e for e, (a, b) in enumerate(pattern.edges)}
     hinge_edge = np.array([edge_of.get((a, b), -1) for a, b in hinges[:, :2]], dtype=np.int64)
@@ -141,13 +146,15 @@ def build_sheet(pattern: CreasePattern, stiffness: Stiffness = Stiffness()) -> S
         elif kinds[e] in ("M", "V", "F") and not np.isnan(angles[e]):
             targets[h] = np.radians(angles[e])
             spring[h] = stiffness.crease if angles[e] != 0 else stiffness.facet
-    return _assemble(flat, centre, radius, triangles, hinges, hinge_edge, targets, spring,
-                     bars, stiffness)
+    return _assemble(flat, centre, radius, (triangles, triangle_face), hinges, hinge_edge,
+                     targets, spring, bars, stiffness)
 
 
-def _assemble(flat, centre, radius, triangles, hinges, hinge_edge, targets, spring, bars,
+def _assemble(flat, centre, radius, cut, hinges, hinge_edge, targets, spring, bars,
               stiffness: Stiffness) -> Sheet:
-    """The :class:`Sheet` with its element arrays: bars, sprung hinges, triangles."""
+    """The :class:`Sheet` with its element arrays: bars, sprung hinges, triangles
+    (``cut``: the triangles and the face of each)."""
+    triangles, triangle_face = cut
     length = np.linalg.norm(flat[bars[:, 1]] - flat[bars[:, 0]], axis=1)
     sprung = np.flatnonzero(spring > 0)
     hinge_length = np.linalg.norm(flat[hinges[sprung, 1]] - flat[hinges[sprung, 0]], axis=1)
@@ -166,5 +173,5 @@ def _assemble(flat, centre, radius, triangles, hinges, hinge_edge, targets, spri
     rest[nb + nh:] = _corner_angles(flat[triangles][:, :, :2])
     hinge_elements = np.full(len(hinges), -1, dtype=np.int64)
     hinge_elements[sprung] = nb + np.arange(nh)
-    return Sheet(flat, centre, radius, triangles, hinges, hinge_edge, targets, nodes, sizes,
-                 kinds, k, rest, hinge_elements)
+    return Sheet(flat, centre, radius, triangles, triangle_face, hinges, hinge_edge, targets,
+                 nodes, sizes, kinds, k, rest, hinge_elements, stiffness)

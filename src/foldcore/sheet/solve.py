@@ -39,24 +39,29 @@ class SheetFold:
     positions : (N, 3) float, mm
     fold_angles_deg : (E,) float, each pattern edge's fold angle, degrees,
         valley > 0; NaN on the boundary
+    target_angles_deg : (E,) float, each crease's target at the fold percent,
+        degrees; NaN where no spring drives it (passive, boundary)
     hinge_angles : (H,) float, radians, every hinge of the sheet (facets included)
     iterations : int, Newton steps taken
     converged : bool, the largest force fell below the tolerance
-    reason : str, ``"converged"``, ``"stalled"`` (no step lowers the energy) or ``"budget"``
+    reason : str, ``"converged"``, ``"stalled"`` (no step lowers the energy),
+        ``"budget"``, ``"callback"`` or ``"interrupted"``
     residual : float, the largest force at the end, normalised units
     energy : float, normalised units
-    seconds : float, wall time of the solve
+    timings_s : dict, seconds: ``solve`` (the Newton steps); the caller may add
+        ``setup`` and ``total``
     """
 
     positions: np.ndarray
     fold_angles_deg: np.ndarray
+    target_angles_deg: np.ndarray
     hinge_angles: np.ndarray
     iterations: int
     converged: bool
     reason: str
     residual: float
     energy: float
-    seconds: float
+    timings_s: dict
 
 
 class Assembly:
@@ -130,46 +135,97 @@ def fold_sheet(sheet: Sheet, fold_percent: float = 100.0, start: np.ndarray | No
                tolerance: float = TOLERANCE, max_iterations: int = MAX_ITERATIONS,
                backend: str = "auto", pattern_edges: int | None = None) -> SheetFold:
     """Settle ``sheet`` at ``fold_percent`` (of every crease's target), from flat
-    or from ``start`` (N, 3) mm; see the module docstring.
+    or from ``start`` (N, 3) mm; see the module docstring and :class:`SheetSolver`."""
+    solver = SheetSolver(sheet, fold_percent, start, backend, pattern_edges)
+    return solver.run(tolerance, max_iterations)
 
-    ``pattern_edges``: the pattern's edge count, for ``fold_angles_deg``
-    (default: the largest edge id the sheet uses + 1).
+
+class SheetSolver:
+    """Newton's method on a :class:`~.build.Sheet`'s energy, one step at a time.
+
+    Parameters
+    ----------
+    sheet : Sheet
+    fold_percent : float, every crease's target × this / 100
+    start : (N, 3) float, mm, optional; default the flat sheet
+    backend : {"auto", "cholmod", "scipy"}, the sparse factorisation
+    pattern_edges : int, optional, the pattern's edge count (``fold_angles_deg``'s
+        length; default the largest edge id the sheet uses + 1)
+
+    ``x`` (N, 3, normalised) and ``iterations`` hold the last accepted iterate, so
+    a run stopped by Ctrl-C still gives its :meth:`result`.
     """
-    t0 = time.perf_counter()
-    energy = Energy(sheet, fold_percent)
-    assembly = Assembly(sheet)
-    x = sheet.flat.copy() if start is None else _normalised(sheet, start)
-    energy.settle_references(x)
-    mu, factor, reason, iterations = MU_START, None, "budget", 0
-    value = energy(x, want_hessian=True)
-    gradient = assembly.gradient(energy.gradients)
-    for iterations in range(max_iterations):
-        if np.max(np.abs(gradient)) < tolerance:
-            reason = "converged"
-            break
-        data = assembly.hessian_values(energy.hessians)
-        scale = max(float(np.max(data[assembly.diagonal])), 1e-300)
-        step, factor, mu = _regularised_step(assembly, data, gradient, mu, scale, factor,
-                                             backend)
-        if step is None:
-            reason = "stalled"
-            break
-        moved, value, full = _line_search(energy, x, value, gradient, step)
-        if moved is None:
-            mu = min(mu * 10.0, MU_CEILING)
-            if mu >= MU_CEILING:
-                reason = "stalled"
+
+    def __init__(self, sheet: Sheet, fold_percent: float = 100.0,
+                 start: np.ndarray | None = None, backend: str = "auto",
+                 pattern_edges: int | None = None):
+        self.sheet, self.backend, self.pattern_edges = sheet, backend, pattern_edges
+        self.energy = Energy(sheet, fold_percent)
+        self.assembly = Assembly(sheet)
+        self.x = sheet.flat.copy() if start is None else _normalised(sheet, start)
+        self.energy.settle_references(self.x)
+        self.iterations, self.seconds = 0, 0.0
+        self.value = self.energy(self.x, want_hessian=True)
+        self.gradient = self.assembly.gradient(self.energy.gradients)
+
+    @property
+    def residual(self) -> float:
+        """The largest force at the current iterate, normalised units."""
+        return float(np.max(np.abs(self.gradient))) if len(self.gradient) else 0.0
+
+    def run(self, tolerance: float = TOLERANCE, max_iterations: int = MAX_ITERATIONS,
+            callback=None) -> SheetFold:
+        """Steps until the largest force is below ``tolerance`` (``"converged"``), no
+        step lowers the energy (``"stalled"``), ``max_iterations`` steps
+        (``"budget"``) or ``callback(solver)`` returns False (``"callback"``)."""
+        t0 = time.perf_counter()
+        mu, factor, reason = MU_START, None, "budget"
+        try:
+            for _ in range(max_iterations):
+                if self.residual < tolerance:
+                    reason = "converged"
+                    break
+                mu, factor, moved = self._step(mu, factor)
+                if moved is None:
+                    reason = "stalled"
+                    break
+                if callback is not None and callback(self) is False:
+                    reason = "callback"
+                    break
+            else:
+                if self.residual < tolerance:
+                    reason = "converged"
+        finally:
+            self.seconds += time.perf_counter() - t0
+        return self.result(reason)
+
+    def _step(self, mu, factor):
+        """(μ, factor, x or None): one damped Newton step, μ raised until one lowers
+        the energy (None when none does)."""
+        data = self.assembly.hessian_values(self.energy.hessians)
+        scale = max(float(np.max(data[self.assembly.diagonal])), 1e-300)
+        while True:
+            step, factor, mu = _regularised_step(self.assembly, data, self.gradient, mu, scale,
+                                                 factor, self.backend)
+            if step is None:
+                return mu, factor, None
+            moved, value, full = _line_search(self.energy, self.x, self.value, self.gradient,
+                                              step)
+            if moved is not None:
                 break
-            continue
-        x = moved
-        energy.settle_references(x)
-        mu = max(mu / 3.0, MU_FLOOR) if full else min(mu * 4.0, MU_CEILING)
-        value = energy(x, want_hessian=True)
-        gradient = assembly.gradient(energy.gradients)
-    else:
-        iterations = max_iterations
-    return _fold(sheet, energy, x, iterations, reason, float(np.max(np.abs(gradient))), value,
-                 time.perf_counter() - t0, pattern_edges)
+            mu *= 10.0
+            if mu >= MU_CEILING:
+                return mu, factor, None
+        self.x, self.value, self.iterations = moved, value, self.iterations + 1
+        self.energy.settle_references(self.x)
+        self.value = self.energy(self.x, want_hessian=True)
+        self.gradient = self.assembly.gradient(self.energy.gradients)
+        return (max(mu / 3.0, MU_FLOOR) if full else min(mu * 4.0, MU_CEILING)), factor, moved
+
+    def result(self, reason: str) -> SheetFold:
+        """The current iterate as a :class:`SheetFold` ending for ``reason``."""
+        return _fold(self.sheet, self.energy, self.x, self.iterations, reason, self.residual,
+                     self.value, self.seconds, self.pattern_edges)
 
 
 def _normalised(sheet: Sheet, positions_mm: np.ndarray) -> np.ndarray:
@@ -223,11 +279,14 @@ def _fold(sheet: Sheet, energy: Energy, x, iterations, reason, residual, value, 
     angles = np.empty(len(sheet.hinges))
     fold_angles(x, sheet.hinges, _hinge_references(sheet, energy), angles)
     count = pattern_edges if pattern_edges is not None else int(sheet.hinge_edge.max()) + 1
-    per_edge = np.full(count, math.nan)
+    per_edge, targets = np.full(count, math.nan), np.full(count, math.nan)
     named = sheet.hinge_edge >= 0
     per_edge[sheet.hinge_edge[named]] = np.degrees(angles[named])
-    return SheetFold(sheet.to_mm(x), per_edge, angles, iterations, reason == "converged",
-                     reason, residual, value, seconds)
+    driven = named & (sheet.hinge_elements >= 0)
+    targets[sheet.hinge_edge[driven]] = np.degrees(
+        energy.rest[sheet.hinge_elements[driven], 0])
+    return SheetFold(sheet.to_mm(x), per_edge, targets, angles, iterations,
+                     reason == "converged", reason, residual, value, {"solve": seconds})
 
 
 def _hinge_references(sheet: Sheet, energy: Energy) -> np.ndarray:

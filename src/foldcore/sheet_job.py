@@ -1,0 +1,113 @@
+"""A fold of a file with no thickness: the thin sheet, from the file to its outputs.
+
+With no thickness (no ``thickening.thickness``, no ``foldcore:thickness`` in
+the file) :func:`foldcore.simulate` folds the pattern as Origami Simulator
+does: a thin sheet of triangles whose facets bend and stretch a little, its
+creases springs toward their targets (:mod:`foldcore.sheet`), settled to
+equilibrium by Newton's method. One line says so. The options of a thick
+sheet (hinges, strategies, contact, sweeps) have no meaning here: each one
+set is refused, naming it, before any work.
+"""
+from __future__ import annotations
+
+import time
+import warnings
+from dataclasses import fields
+
+from .errors import RunWarning
+from .options import OptionError, Outputs, Solving, Thickening
+
+#: The line a thin-sheet run says first.
+THIN_NOTE = ("no thickness given: folded as a thin sheet (Origami Simulator's model: "
+             "facets bend, creases are springs toward their targets); give "
+             "thickening.thickness (mm) for a thick sheet")
+#: Options of a thick sheet only: (group, field) with the defaults of its class.
+THICK_ONLY = (("thickening", Thickening, ("hinge_width", "subdivisions", "hinge",
+                                          "elastic_cells")),
+              ("solving", Solving, ("solver", "actuation", "branch_floor", "strategy_options",
+                                    "contact", "obstacles", "ground")),
+              ("outputs", Outputs, ("animate", "series")))
+
+
+def thick_options_set(job) -> list[str]:
+    """``group.field`` of every option of a thick sheet only that ``job`` sets."""
+    out = []
+    for group, cls, names in THICK_ONLY:
+        defaults = {f.name: f.default for f in fields(cls)}
+        values = getattr(job, group)
+        out += [f"{group}.{n}" for n in names if getattr(values, n) != defaults[n]]
+    return out
+
+
+def check_thin(job) -> None:
+    """OptionError naming the first thick-sheet option ``job`` sets."""
+    named = thick_options_set(job)
+    if named:
+        raise OptionError(f"{job.source}: {named[0]} is an option of a thick sheet, and this "
+                          "pattern has no thickness, so it is folded as a thin sheet: give "
+                          "thickening.thickness (mm), or leave it out")
+
+
+def run_thin(job, loaded, on_start=None, callback=None):
+    """(sheet, solver, result, interrupted): ``job``'s pattern (``loaded``, the file
+    read) folded as a thin sheet. Ctrl-C ends the run with its last iterate
+    (``interrupted`` True, ``result.reason == "interrupted"``)."""
+    from .sheet import SheetSolver, build_sheet
+
+    warnings.warn(f"{job.source}: {THIN_NOTE}", RunWarning, stacklevel=3)
+    s, pattern = job.solving, loaded.pattern
+    t0 = time.perf_counter()
+    sheet = build_sheet(pattern)
+    solver = SheetSolver(sheet, s.fold_percent, pattern_edges=pattern.n_edges)
+    setup = time.perf_counter() - t0
+    if on_start is not None:
+        on_start()
+    try:
+        result, interrupted = solver.run(s.tolerance, s.max_iterations,
+                                         _callback(callback)), False
+    except KeyboardInterrupt:
+        result, interrupted = solver.result("interrupted"), True
+    result.timings_s.update(setup=setup, total=setup + result.timings_s["solve"])
+    return sheet, solver, result, interrupted
+
+
+def thin_summary(job, pattern, result) -> str:
+    """The run's one-line summary; the warnings it calls for are issued."""
+    from .outputs import run_summary
+
+    summary, said = run_summary(result, pattern, job.source, job.solving.fold_percent,
+                                model="sheet")
+    for text in said:
+        warnings.warn(text, RunWarning, stacklevel=3)
+    return summary
+
+
+def write_thin(job, pattern, sheet, result, partial: bool) -> None:
+    """The outputs ``job`` asks for (:func:`foldcore.sheet_outputs.write_sheet_result`)."""
+    from .sheet_outputs import write_sheet_result
+
+    out = job.outputs
+    write_sheet_result(result, pattern, sheet, thin_settings(job), fold_path=out.fold,
+                       report=out.report, png=out.render, partial=partial)
+
+
+def _callback(callback):
+    """The job's ``callback(sim, moved_mm)`` as the solver's ``callback(solver)``."""
+    if callback is None:
+        return None
+    last = {}
+
+    def step(solver):
+        x = solver.x * solver.sheet.radius
+        moved = float(abs(x - last["x"]).max()) if "x" in last else float("nan")
+        last["x"] = x
+        return callback(solver, moved)
+    return step
+
+
+def thin_settings(job) -> dict:
+    """What the report records of a thin-sheet run's settings."""
+    s = job.solving
+    return {"pattern": job.source, "model": "sheet", "fold_percent": s.fold_percent,
+            "tolerance": s.tolerance, "max_iterations": s.max_iterations,
+            "thickness_mm": None}

@@ -1,0 +1,89 @@
+"""What a thin-sheet fold writes: the result FOLD, the JSON report, the PNG.
+
+The result FOLD is the crease pattern (its ``edges_foldAngle`` the achieved
+angles) with one ``foldedForm`` frame: the pattern's vertices where the sheet
+put them (mm) and the sheet's triangles, each naming the pattern face it cuts
+(``foldcore:faces_face``). The file says ``"foldcore:model": "sheet"`` and has
+no ``foldcore:thickness``. The data files are written all or nothing, the
+picture after them (:func:`foldcore.outputs.write_picture`).
+"""
+from __future__ import annotations
+
+from dataclasses import asdict
+
+import numpy as np
+
+from .io.fold_json import MODEL_KEY
+from .outputs import (FACE_PART_KEY, PARTIAL_KEY, actuation_entries, in_fold_range,
+                      machine_entries, write_picture, write_report)
+
+MODEL = "sheet"
+
+
+def sheet_frame(sheet, positions: np.ndarray) -> dict:
+    """FOLD frame of the folded sheet: 3D coordinates (mm), triangles, the face of each."""
+    return {"frame_classes": ["foldedForm"], "frame_attributes": ["3D"],
+            "frame_unit": "mm", "frame_parent": 0, "frame_inherit": False,
+            "vertices_coords": np.asarray(positions).tolist(),
+            "faces_vertices": sheet.triangles.tolist(),
+            FACE_PART_KEY: sheet.triangle_face.tolist()}
+
+
+def sheet_report(fold, pattern, sheet, settings: dict) -> dict:
+    """The JSON report of a thin-sheet fold: verdict, angles and misses (degrees,
+    valley > 0), the sheet's make-up, its stiffnesses (Origami Simulator's
+    conventions, normalised frame), timings (s) and the settings used."""
+    facets = int(np.count_nonzero(sheet.hinge_edge < 0))
+    sprung = sheet.hinge_elements >= 0
+    return {
+        "model": MODEL,
+        "iterations": int(fold.iterations),
+        "converged": bool(fold.converged),
+        "reason": fold.reason,
+        "residual": float(fold.residual),
+        "residual_unit": "largest force, normalised frame (sheet radius 1)",
+        "energy": float(fold.energy),
+        "fold_angles_deg": _nullable(fold.fold_angles_deg),
+        "target_angles_deg": _nullable(fold.target_angles_deg),
+        "actuation": actuation_entries(fold, pattern),
+        "sheet": {"vertices": int(len(sheet.flat)), "triangles": int(len(sheet.triangles)),
+                  "creases": int(np.count_nonzero(sprung & (sheet.hinge_edge >= 0))),
+                  "facet_hinges": facets,
+                  "free_hinges": int(np.count_nonzero(~sprung)),
+                  "radius_mm": float(sheet.radius),
+                  "stiffness": asdict(sheet.constants)},
+        "timings_s": {k: float(v) for k, v in fold.timings_s.items()},
+        "settings": settings,
+        "machine": machine_entries(),
+    }
+
+
+def _nullable(values) -> list:
+    return [float(v) if np.isfinite(v) else None for v in np.asarray(values, dtype=float)]
+
+
+def write_sheet_result(fold, pattern, sheet, settings: dict, *, fold_path=None, report=None,
+                       png=None, partial: bool = False) -> None:
+    """Write the outputs asked for (module docstring); None skips one.
+
+    ``partial``: the run was interrupted, said in both files as the thick
+    sheet's outputs say it (:func:`foldcore.outputs.write_result`).
+    """
+    from .files import all_or_nothing
+    from .io import write_fold
+
+    with all_or_nothing({"fold": fold_path, "report": report}) as tmp:
+        if fold_path:
+            extra = {MODEL_KEY: MODEL, **({PARTIAL_KEY: True} if partial else {})}
+            write_fold(tmp["fold"], pattern, achieved_angles=in_fold_range(fold.fold_angles_deg),
+                       frames=[sheet_frame(sheet, fold.positions)], extra=extra)
+        if report:
+            write_report(tmp["report"], {**sheet_report(fold, pattern, sheet, settings),
+                                         **({"partial": True} if partial else {})})
+    if png:
+        from .sheet_render import render_sheet_png
+
+        write_picture(png, lambda path: render_sheet_png(pattern, sheet.triangles,
+                                                         fold.positions, path),
+                      written=[p for p in (fold_path, report) if p])
+

@@ -1,0 +1,108 @@
+"""A pattern with no thickness folds as a thin sheet (:mod:`foldcore.sheet_job`):
+the note, the outputs and what they hold, the thick-only options refused."""
+from __future__ import annotations
+
+import json
+import warnings
+
+import numpy as np
+import pytest
+
+import foldcore
+from foldcore import cli, patterns
+from foldcore.errors import RunWarning
+from foldcore.io import write_fold
+from foldcore.sheet import SheetFold
+
+REAL = "tests/data/real/"
+
+
+def _dihedral_deg(x, a, b, c, d):
+    """Fold angle (degrees, valley > 0) of the crease a → b with c left, d right,
+    measured from the points alone (numpy, independent of the kernels)."""
+    e = x[b] - x[a]
+    n1 = np.cross(x[b] - x[a], x[c] - x[a])   # upward normal of the left triangle
+    n2 = np.cross(x[d] - x[a], x[b] - x[a])   # and of the right one
+    sine = np.dot(np.cross(n1, n2), e) / np.linalg.norm(e)
+    return np.degrees(np.arctan2(-sine, np.dot(n1, n2)))
+
+
+@pytest.fixture
+def miura_file(tmp_path):
+    """A 3 × 3 Miura at half its rigid-fold angles (not rigidly compatible: facets bend)."""
+    angles = 0.5 * patterns.miura_fold_angles(3, 3, 60.0, 50.0)
+    path = tmp_path / "miura.fold"
+    write_fold(path, patterns.miura(3, 3, gamma=60.0).replace(fold_angles=angles))
+    return path
+
+
+def test_no_thickness_folds_a_thin_sheet_and_writes_what_it_measured(miura_file, tmp_path,
+                                                                      capsys):
+    out, report, png = tmp_path / "r.fold", tmp_path / "r.json", tmp_path / "r.png"
+    assert cli.main(["simulate", str(miura_file), "--fold-percent", "80", "-o", str(out),
+                     "--report", str(report), "--render", str(png)]) == 0
+    err = capsys.readouterr().err
+    assert "no thickness given: folded as a thin sheet" in err and "--thickness" in err
+    data, rep = json.loads(out.read_text()), json.loads(report.read_text())
+    assert data["foldcore:model"] == "sheet" and "foldcore:thickness" not in data
+    assert rep["model"] == "sheet" and rep["converged"] and rep["reason"] == "converged"
+    assert png.stat().st_size > 0
+    frame = data["file_frames"][0]
+    x = np.array(frame["vertices_coords"])
+    pattern = foldcore.io.read(miura_file)
+    assert x.shape == (pattern.n_vertices, 3)
+    # every triangle names its pattern face; the faces are covered
+    assert sorted(set(frame["foldcore:faces_face"])) == list(range(len(pattern.faces)))
+    # the angles written are those of the folded form, measured independently
+    tris = np.array(frame["faces_vertices"])
+    left = {(t[i], t[(i + 1) % 3]): t[(i + 2) % 3] for t in tris for i in range(3)}
+    for e, (a, b) in enumerate(np.asarray(pattern.edges)):
+        if pattern.assignments[e] == "B":
+            assert rep["fold_angles_deg"][e] is None
+            continue
+        if (a, b) not in left:
+            a, b = b, a
+        measured = _dihedral_deg(x, a, b, left[(a, b)], left[(b, a)])
+        assert rep["fold_angles_deg"][e] == pytest.approx(measured, abs=1e-9)
+        assert data["edges_foldAngle"][e] == pytest.approx(measured, abs=1e-9)
+    # the targets are 80 % of the file's
+    targets = np.array([np.nan if t is None else t for t in rep["target_angles_deg"]])
+    assert np.allclose(targets, 0.8 * np.asarray(pattern.fold_angles), equal_nan=True)
+
+
+def test_library_call_gives_the_sheet_fold_and_a_thickness_still_gives_a_thick_one(miura_file):
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        thin = foldcore.simulate(miura_file, solving={"fold_percent": 50})
+    assert isinstance(thin, SheetFold) and thin.converged
+    assert any(issubclass(w.category, RunWarning) and "thin sheet" in str(w.message)
+               for w in caught)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RunWarning)
+        thick = foldcore.simulate(miura_file, thickening={"thickness": 0.2},
+                                  solving={"fold_percent": 50, "max_iterations": 50})
+    assert not isinstance(thick, SheetFold)
+
+
+@pytest.mark.parametrize("flag", [["--hinge", "arc"], ["--hinge-width", "1"],
+                                  ["--elastic-cells", "5"], ["--solver", "newton"],
+                                  ["--contact", "on"], ["--series", "s.fold"]])
+def test_options_of_a_thick_sheet_are_refused_before_any_work(miura_file, tmp_path, capsys,
+                                                              flag):
+    out = tmp_path / "r.fold"
+    args = [a if a != "s.fold" else str(tmp_path / a) for a in flag]
+    assert cli.main(["simulate", str(miura_file), "-o", str(out), *args]) == 2
+    err = capsys.readouterr().err
+    assert f"{flag[0]} is an option of a thick sheet" in err and "Traceback" not in err
+    assert not out.exists()
+
+
+def test_origami_simulator_svg_folds_without_a_thickness(tmp_path):
+    """An Origami Simulator file as it comes (no thickness in an SVG)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RunWarning)
+        fold = foldcore.simulate(REAL + "waterbombBase.svg", solving={"fold_percent": 90},
+                                 outputs={"report": tmp_path / "w.json"})
+    assert fold.converged
+    report = json.loads((tmp_path / "w.json").read_text())
+    assert report["sheet"]["triangles"] == len(foldcore.io.read(REAL + "waterbombBase.svg").faces)
