@@ -1,9 +1,9 @@
 """numba kernels of the bar-and-hinge sheet: energy, gradient and Hessian.
 
 Three element kinds, each with its analytic gradient; the Hessian of an
-element is the central difference of its gradient (exact to ~1e-10 relative
-at these sizes, and one code path instead of three hand-derived second
-derivatives that are easy to get wrong):
+element is the forward difference of its gradient (exact to ~1e-8 relative
+at these sizes, plenty for Newton's steps, and one code path instead of
+three hand-derived second derivatives that are easy to get wrong):
 
 * **bar** ``(a, b)``: ``½ k (L − L₀)²``;
 * **hinge** ``(a, b, c, d)``: ``½ k (φ − φ̄)²``, the hinge on ``a → b``, ``c``
@@ -27,18 +27,18 @@ from elements.cache import choose_cache_dir
 
 choose_cache_dir(Path(__file__))  # before this module's cache=True kernels (read-only installs)
 
-STEP = 1e-6  # central-difference step of the Hessians, normalised units
+STEP = 1e-8  # forward-difference step of the Hessians, normalised units (√ε: ~1e-8 relative)
 
 
 @njit(cache=True, inline="always")
-def _sub(x, i, j):
-    return np.array((x[i, 0] - x[j, 0], x[i, 1] - x[j, 1], x[i, 2] - x[j, 2]))
+def _vec(p, i, j):
+    """p[i] − p[j] as a 3-tuple (no allocation)."""
+    return (p[i, 0] - p[j, 0], p[i, 1] - p[j, 1], p[i, 2] - p[j, 2])
 
 
 @njit(cache=True, inline="always")
 def _cross(u, v):
-    return np.array((u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2],
-                     u[0] * v[1] - u[1] * v[0]))
+    return (u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0])
 
 
 @njit(cache=True, inline="always")
@@ -50,10 +50,12 @@ def _dot(u, v):
 def fold_angle(p, reference):
     """Fold angle (radians) of hinge points ``p`` (4, 3) = (a, b, c, d), the value
     of ``atan2`` plus the multiple of 2π nearest ``reference``."""
-    e = p[1] - p[0]
-    m = _cross(p[2] - p[0], e)   # normal of the left triangle (c side), length 2 A₁
-    n = _cross(e, p[3] - p[0])   # normal of the right triangle (d side)
+    e = _vec(p, 1, 0)
+    m = _cross(_vec(p, 2, 0), e)   # normal of the left triangle (c side), length 2 A₁
+    n = _cross(e, _vec(p, 3, 0))   # normal of the right triangle (d side)
     le = math.sqrt(_dot(e, e))
+    if le == 0.0:
+        return reference  # a collapsed hinge has no angle of its own
     phi = math.atan2(_dot(_cross(n, m), e) / le, _dot(m, n))
     return phi + 2.0 * math.pi * round((reference - phi) / (2.0 * math.pi))
 
@@ -62,36 +64,38 @@ def fold_angle(p, reference):
 def fold_angle_gradient(p, g):
     """∂φ/∂p of hinge points ``p`` (4, 3) into ``g`` (4, 3); False when a triangle
     is degenerate (g left zero)."""
-    e = p[1] - p[0]
+    e = _vec(p, 1, 0)
     ee = _dot(e, e)
-    m = _cross(p[2] - p[0], e)
-    n = _cross(e, p[3] - p[0])
+    rc, rd = _vec(p, 2, 0), _vec(p, 3, 0)
+    m = _cross(rc, e)
+    n = _cross(e, rd)
     mm, nn = _dot(m, m), _dot(n, n)
     g[:] = 0.0
     if ee <= 0.0 or mm <= 1e-30 * ee * ee or nn <= 1e-30 * ee * ee:
         return False
     le = math.sqrt(ee)
-    gc = -le / mm * m
-    gd = -le / nn * n
-    sc = _dot(p[2] - p[0], e) / ee
-    sd = _dot(p[3] - p[0], e) / ee
-    g[2] = gc
-    g[3] = gd
-    g[0] = -(1.0 - sc) * gc - (1.0 - sd) * gd
-    g[1] = -sc * gc - sd * gd
+    sc, sd = _dot(rc, e) / ee, _dot(rd, e) / ee
+    for k in range(3):
+        gc = -le / mm * m[k]
+        gd = -le / nn * n[k]
+        g[2, k] = gc
+        g[3, k] = gd
+        g[0, k] = -(1.0 - sc) * gc - (1.0 - sd) * gd
+        g[1, k] = -sc * gc - sd * gd
     return True
 
 
 @njit(cache=True)
 def _bar_gradient(p, k, rest, g):
-    d = p[1] - p[0]
+    d = _vec(p, 1, 0)
     length = math.sqrt(_dot(d, d))
     if length <= 0.0:
         g[:] = 0.0
         return 0.0
     f = k * (length - rest) / length
-    g[0] = -f * d
-    g[1] = f * d
+    for c in range(3):
+        g[0, c] = -f * d[c]
+        g[1, c] = f * d[c]
     return 0.5 * k * (length - rest) ** 2
 
 
@@ -107,21 +111,23 @@ def _hinge_gradient(p, k, target, reference, g):
 def _corner(p, i, j, l, k, rest, g):
     """Add ½ k (α − rest)² of the corner at p[i] (between p[j], p[l]) and its
     gradient into g; returns the energy."""
-    u = p[j] - p[i]
-    v = p[l] - p[i]
+    u = _vec(p, j, i)
+    v = _vec(p, l, i)
     n = _cross(u, v)
     s = math.sqrt(_dot(n, n))
     uu, vv = _dot(u, u), _dot(v, v)
     if s <= 1e-30 * (uu + vv) or uu <= 0.0 or vv <= 0.0:
         return 0.0
     alpha = math.atan2(s, _dot(u, v))
-    n = n / s
-    gj = -_cross(n, u) / uu
-    gl = _cross(n, v) / vv
+    n = (n[0] / s, n[1] / s, n[2] / s)
+    nu, nv = _cross(n, u), _cross(n, v)
     f = k * (alpha - rest)
-    g[j] += f * gj
-    g[l] += f * gl
-    g[i] -= f * (gj + gl)
+    for c in range(3):
+        gj = -nu[c] / uu
+        gl = nv[c] / vv
+        g[j, c] += f * gj
+        g[l, c] += f * gl
+        g[i, c] -= f * (gj + gl)
     return 0.5 * k * (alpha - rest) ** 2
 
 
@@ -167,23 +173,27 @@ def evaluate(x, nodes, sizes, kinds, stiffness, rest, reference, energy, gradien
             p[a] = x[nodes[e, a]]
         g = np.zeros((size, 3))
         energy[e] = _element_gradient(kinds[e], p, stiffness[e], rest[e], reference[e], g)
-        gradient[e, :3 * size] = g.ravel()
+        for a in range(size):
+            for c in range(3):
+                gradient[e, 3 * a + c] = g[a, c]
         if not want_hessian:
             continue
         gp = np.zeros((size, 3))
-        gm = np.zeros((size, 3))
         for a in range(size):
             for c in range(3):
                 keep = p[a, c]
                 p[a, c] = keep + STEP
                 _element_gradient(kinds[e], p, stiffness[e], rest[e], reference[e], gp)
-                p[a, c] = keep - STEP
-                _element_gradient(kinds[e], p, stiffness[e], rest[e], reference[e], gm)
                 p[a, c] = keep
                 column = 3 * a + c
-                hessian[e, :3 * size, column] = (gp.ravel() - gm.ravel()) / (2.0 * STEP)
-        h = hessian[e, :3 * size, :3 * size]
-        hessian[e, :3 * size, :3 * size] = 0.5 * (h + h.T)
+                for b in range(size):
+                    for d in range(3):
+                        hessian[e, 3 * b + d, column] = (gp[b, d] - g[b, d]) / STEP
+        for i in range(3 * size):  # symmetric: the mean of the two differences
+            for j in range(i):
+                mean = 0.5 * (hessian[e, i, j] + hessian[e, j, i])
+                hessian[e, i, j] = mean
+                hessian[e, j, i] = mean
 
 
 @njit(cache=True, parallel=True)
