@@ -41,7 +41,7 @@ def sheet_report(fold, pattern, sheet, settings: dict) -> dict:
         "converged": bool(fold.converged),
         "reason": fold.reason,
         "residual": float(fold.residual),
-        "residual_unit": "largest force, normalised frame (sheet radius 1)",
+        "residual_unit": "largest force imbalance at a node / the forces meeting there",
         "energy": float(fold.energy),
         "fold_angles_deg": _nullable(fold.fold_angles_deg),
         "target_angles_deg": _nullable(fold.target_angles_deg),

@@ -23,7 +23,7 @@ from ..linsolve import Factor, not_positive_definite
 from .build import HINGE, Sheet
 from .kernels import evaluate, fold_angles
 
-TOLERANCE = 1e-9       # largest force at equilibrium, normalised units (module docstring)
+TOLERANCE = 1e-8       # largest relative force imbalance at equilibrium (SheetSolver.residual)
 MAX_ITERATIONS = 500
 MU_START, MU_FLOOR, MU_CEILING = 1e-3, 1e-9, 1e12
 ARMIJO, HALVINGS = 1e-4, 40
@@ -46,7 +46,8 @@ class SheetFold:
     converged : bool, the largest force fell below the tolerance
     reason : str, ``"converged"``, ``"stalled"`` (no step lowers the energy),
         ``"budget"``, ``"callback"`` or ``"interrupted"``
-    residual : float, the largest force at the end, normalised units
+    residual : float, the largest relative force imbalance at a node at the end
+        (:attr:`SheetSolver.residual`)
     energy : float, normalised units
     timings_s : dict, seconds: ``solve`` (the Newton steps); the caller may add
         ``setup`` and ``total``
@@ -76,6 +77,9 @@ class Assembly:
             for c in range(3):
                 dofs[used, 3 * a + c] = 3 * sheet.nodes[used, a] + c
         self.n = n
+        used = np.arange(4)[None, :] < sizes[:, None]
+        self.node_take = np.flatnonzero(used.ravel())
+        self.node_rows = sheet.nodes[used]
         self.gradient_rows = dofs[dofs >= 0]
         self.gradient_take = np.flatnonzero((dofs >= 0).ravel())
         pair = (dofs[:, :, None] >= 0) & (dofs[:, None, :] >= 0)
@@ -92,6 +96,13 @@ class Assembly:
         """(3N,) global gradient of (M, 12) element gradients."""
         values = element_gradients.ravel()[self.gradient_take]
         return np.bincount(self.gradient_rows, weights=values, minlength=self.n)
+
+    def node_force_sums(self, element_gradients: np.ndarray) -> np.ndarray:
+        """(N,) Σ over elements of the length of each one's force on the node."""
+        per_node = np.linalg.norm(element_gradients.reshape(len(element_gradients), 4, 3),
+                                  axis=2).ravel()
+        return np.bincount(self.node_rows, weights=per_node[self.node_take],
+                           minlength=self.n // 3)
 
     def hessian_values(self, element_hessians: np.ndarray) -> np.ndarray:
         """CSC data of the global Hessian of (M, 12, 12) element Hessians."""
@@ -165,13 +176,23 @@ class SheetSolver:
         self.x = sheet.flat.copy() if start is None else _normalised(sheet, start)
         self.energy.settle_references(self.x)
         self.iterations, self.seconds = 0, 0.0
+        self.unit_force = unit_force(sheet)
         self.value = self.energy(self.x, want_hessian=True)
         self.gradient = self.assembly.gradient(self.energy.gradients)
 
     @property
     def residual(self) -> float:
-        """The largest force at the current iterate, normalised units."""
-        return float(np.max(np.abs(self.gradient))) if len(self.gradient) else 0.0
+        """The largest force imbalance at a node, relative to the forces meeting there:
+        max over nodes of |Σₑ fₑ| / (Σₑ |fₑ| + F₁), fₑ each element's force on the
+        node, F₁ :func:`unit_force` (so a sheet at rest, all forces zero, is judged
+        against its springs' scale). A node where a sliver triangle's springs
+        pull with forces of 10³ is settled when they cancel to 10⁻⁵; a node of
+        ordinary triangles needs the same digits of its own forces."""
+        if not len(self.gradient):
+            return 0.0
+        meeting = self.assembly.node_force_sums(self.energy.gradients)
+        imbalance = np.linalg.norm(self.gradient.reshape(-1, 3), axis=1)
+        return float(np.max(imbalance / (meeting + self.unit_force)))
 
     def run(self, tolerance: float = TOLERANCE, max_iterations: int = MAX_ITERATIONS,
             callback=None) -> SheetFold:
@@ -203,14 +224,15 @@ class SheetSolver:
         """(μ, factor, x or None): one damped Newton step, μ raised until one lowers
         the energy (None when none does)."""
         data = self.assembly.hessian_values(self.energy.hessians)
-        scale = max(float(np.max(data[self.assembly.diagonal])), 1e-300)
+        diagonal = np.abs(data[self.assembly.diagonal])
+        scale = diagonal + max(float(np.median(diagonal)), 1e-300)
         while True:
             step, factor, mu = _regularised_step(self.assembly, data, self.gradient, mu, scale,
                                                  factor, self.backend)
             if step is None:
                 return mu, factor, None
-            moved, value, full = _line_search(self.energy, self.x, self.value, self.gradient,
-                                              step)
+            moved, value, full = _line_search(self.energy, self.assembly, self.x, self.value,
+                                              self.gradient, step)
             if moved is not None:
                 break
             mu *= 10.0
@@ -228,6 +250,24 @@ class SheetSolver:
                      self.value, self.seconds, self.pattern_edges)
 
 
+def unit_force(sheet: Sheet) -> float:
+    """The force scale of the sheet's springs: the median over its sprung hinges of
+    the force a 1-radian miss puts on a hinge's tip, k / h (h the tip's height
+    over the hinge in the flat sheet), normalised units; 1 without springs."""
+    hinges = sheet.nodes[sheet.kinds == HINGE]
+    if not len(hinges):
+        return 1.0
+    p = sheet.flat[:, :2]
+    e = p[hinges[:, 1]] - p[hinges[:, 0]]
+    length = np.linalg.norm(e, axis=1)
+    heights = []
+    for tip in (2, 3):
+        r = p[hinges[:, tip]] - p[hinges[:, 0]]
+        heights.append(np.abs(e[:, 0] * r[:, 1] - e[:, 1] * r[:, 0]) / length)
+    k = sheet.stiffness[sheet.kinds == HINGE]
+    return float(np.median(k / np.minimum(*heights)))
+
+
 def _normalised(sheet: Sheet, positions_mm: np.ndarray) -> np.ndarray:
     x = np.array(positions_mm, dtype=float) / sheet.radius
     x[:, :2] -= sheet.centre / sheet.radius
@@ -235,7 +275,7 @@ def _normalised(sheet: Sheet, positions_mm: np.ndarray) -> np.ndarray:
 
 
 def _regularised_step(assembly: Assembly, data, gradient, mu, scale, factor, backend):
-    """(step, factor, μ): the solution of (H + μ·scale·I) Δ = −g, raising μ until the
+    """(step, factor, μ): the solution of (H + μ·diag(scale)) Δ = −g, raising μ until the
     matrix factors; (None, factor, μ) when it never does."""
     while mu < MU_CEILING:
         shifted = data.copy()
@@ -255,21 +295,25 @@ def _regularised_step(assembly: Assembly, data, gradient, mu, scale, factor, bac
     return None, factor, mu
 
 
-def _line_search(energy: Energy, x, value, gradient, step):
+def _line_search(energy: Energy, assembly: Assembly, x, value, gradient, step):
     """(x + t·step, its energy, t == 1) for the largest t = 2⁻ᵏ meeting Armijo's
-    condition; (None, value, False) when none does."""
+    condition, or, where the energy's change is below its rounding
+    (:data:`ROUNDOFF`), lowering the largest force instead; (None, value, False)
+    when no t does."""
     slope = float(gradient @ step)
     if slope >= 0.0:
         return None, value, False
     t = 1.0
     flat_step = step.reshape(-1, 3)
+    force = float(np.max(np.abs(gradient)))
     for _ in range(HALVINGS):
         trial = x + t * flat_step
         trial_value = energy(trial)
         if trial_value <= value + ARMIJO * t * slope:
             return trial, trial_value, t == 1.0
-        if trial_value - value <= ROUNDOFF * abs(value) and t == 1.0:
-            return trial, trial_value, True  # a change below the energy's rounding
+        if abs(trial_value - value) <= ROUNDOFF * abs(value) and \
+                np.max(np.abs(assembly.gradient(energy.gradients))) < force:
+            return trial, trial_value, t == 1.0  # below the energy's rounding: the forces
         t *= 0.5
     return None, value, False
 
