@@ -1,7 +1,8 @@
 """A crease pattern as a bar-and-hinge sheet (:class:`Sheet`), Origami Simulator's way.
 
 Each face is cut into triangles as Origami Simulator cuts it (a quadrilateral
-along its shorter diagonal, the first one on a tie; a larger face by earcut);
+along its shorter diagonal, or on a tie the one through its lowest vertex id,
+which is the one Origami Simulator's face order picks; a larger face by earcut);
 the new diagonals are facet creases, held flat. Every edge is a bar; every
 edge between two triangles is a hinge: a crease spring where the pattern
 gives the crease a target (``M``, ``V`` or ``F``), a facet spring on a
@@ -19,6 +20,7 @@ from ..pattern import CreasePattern
 from ..triangulation import triangulate_polygon
 
 BAR, HINGE, TRIANGLE = 0, 1, 2
+TIE = 1e-9  # diagonals of a quadrilateral this close (relative, squared) are equal
 
 
 @dataclass(frozen=True)
@@ -90,7 +92,12 @@ def face_triangles(xy: np.ndarray, loop: np.ndarray, face: int) -> np.ndarray:
         return loop[None, :].copy()
     if len(loop) == 4:
         p = xy[loop]
-        if np.sum((p[1] - p[3]) ** 2) < np.sum((p[0] - p[2]) ** 2):
+        across_02, across_13 = np.sum((p[0] - p[2]) ** 2), np.sum((p[1] - p[3]) ** 2)
+        if abs(across_02 - across_13) <= TIE * max(across_02, across_13):
+            use_13 = int(np.argmin(loop)) % 2 == 1  # a tie: the diagonal through the lowest id
+        else:
+            use_13 = across_13 < across_02
+        if use_13:
             return loop[np.array([[0, 1, 3], [1, 2, 3]])]
         return loop[np.array([[0, 1, 2], [0, 2, 3]])]
     return loop[triangulate_polygon(xy[loop], face)]
