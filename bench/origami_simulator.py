@@ -79,9 +79,9 @@ FOLDCORE_CASE = "arc, graded W, H = 0.01a"
 N, M, A, GAMMA, H_OVER_A = 12, 13, 80.0, 84.0, 0.01  # facets, mm, degrees
 TOLERANCE, BUDGET = 1e-9, 5_000
 HARNESS_PAGE = "foldcore_harness.html"
-#: what the page needs (a snapshot may lack its largest files, e.g. other demos)
-PAGE_FILES = ("index.html", "favicon.ico", "js", "css", "dependencies", "fonts",
-              "assets/Tessellations")
+#: what the page needs: the app and every demo it ships (a snapshot may lack some
+#: large files, e.g. a .fold demo: those are left out, see ``absent_files``)
+PAGE_FILES = ("index.html", "favicon.ico", "js", "css", "dependencies", "fonts", "assets")
 
 HARNESS_JS = """
 (function () {
@@ -137,46 +137,83 @@ HARNESS_JS = """
 """
 
 
+def git(source: Path, *args: str, stdin: bytes | None = None) -> bytes:
+    """Output of ``git --git-dir source args`` (raises on failure)."""
+    return subprocess.run(["git", "--git-dir", str(source), *args], input=stdin,
+                          capture_output=True, check=True).stdout
+
+
+def absent_files(source: Path, paths=PAGE_FILES) -> list[str]:
+    """Files under ``paths`` at HEAD of the bare git dir ``source`` whose content
+    the snapshot lacks (a partial clone leaves out some large blobs)."""
+    tree = git(source, "ls-tree", "-r", "-z", "HEAD", "--", *paths).decode()
+    entries = [line.split("\t", 1) for line in tree.split("\0") if line]
+    blobs = [(meta.split()[2], path) for meta, path in entries if meta.split()[1] == "blob"]
+    check = git(source, "cat-file", "--batch-check=%(objectname) %(objecttype)",
+                stdin="".join(f"{sha}\n" for sha, _ in blobs).encode()).decode().splitlines()
+    return [path for (_, path), line in zip(blobs, check) if line.endswith(" missing")]
+
+
 def extract(source: Path, into: Path) -> str:
-    """Origami Simulator's files (``PAGE_FILES``) from ``source`` (bare git dir or
-    checkout) into ``into``; returns the commit (or "checkout")."""
+    """Origami Simulator's files (``PAGE_FILES``, less ``absent_files``) from
+    ``source`` (bare git dir or checkout) into ``into``; returns the commit (or
+    "checkout")."""
     if (source / "index.html").exists():
         shutil.copytree(source, into, dirs_exist_ok=True)
         return "checkout"
-    commit = subprocess.run(["git", "--git-dir", str(source), "rev-parse", "HEAD"],
-                            capture_output=True, text=True, check=True).stdout.strip()
-    archive = subprocess.run(["git", "--git-dir", str(source), "archive", "HEAD", *PAGE_FILES],
-                             capture_output=True, check=True).stdout
+    commit = git(source, "rev-parse", "HEAD").decode().strip()
+    left_out = [f":(exclude){path}" for path in absent_files(source)]
+    archive = git(source, "archive", "HEAD", "--", *PAGE_FILES, *left_out)
     subprocess.run(["tar", "-x", "-C", str(into)], input=archive, check=True)
     return commit
 
 
-def harness_page(root: Path, strains, limit_s: float) -> None:
-    """``HARNESS_PAGE`` in ``root``: index.html without the script it loads from
-    Google (its inline ``gtag`` stub, which the app calls, stays: it only queues),
-    the harness script (thresholds ``strains``, %, and ``limit_s``) after main.js."""
+def page_with_script(root: Path, script: str, name: str = HARNESS_PAGE) -> None:
+    """``name`` in ``root``: index.html without the script it loads from Google
+    (its inline ``gtag`` stub, which the app calls, stays: it only queues), with
+    ``script`` (JavaScript) after main.js."""
     html = (root / "index.html").read_text()
     start = html.index('<script async src="https://www.googletagmanager.com')
     end = html.index("</script>", start) + len("</script>")
     html = html[:start] + html[end:]
-    script = HARNESS_JS % {"strains": json.dumps(list(strains)), "limit": limit_s}
     anchor = '<script type="text/javascript" src="js/main.js"></script>'
     if anchor not in html:
         raise SystemExit("origami_simulator: index.html has no main.js script tag "
                          "(another Origami Simulator version?)")
     html = html.replace(anchor, anchor + "\n<script>" + script + "</script>")
-    (root / HARNESS_PAGE).write_text(html)
+    (root / name).write_text(html)
+
+
+def harness_page(root: Path, strains, limit_s: float) -> None:
+    """``HARNESS_PAGE`` in ``root``: the page with this benchmark's harness script
+    (thresholds ``strains``, %, and ``limit_s``)."""
+    page_with_script(root, HARNESS_JS % {"strains": json.dumps(list(strains)),
+                                         "limit": limit_s})
 
 
 class Server:
-    """Static files of ``root`` on 127.0.0.1; the harness's POST lands in ``results``."""
+    """Static files of ``root`` on 127.0.0.1; the harness's POST lands in ``results``;
+    a GET of a path in ``routes`` answers ``routes[path]()`` as JSON."""
 
-    def __init__(self, root: Path):
+    def __init__(self, root: Path, routes: dict | None = None):
         results: queue.Queue = queue.Queue()
+        routes = routes or {}
 
         class Handler(http.server.SimpleHTTPRequestHandler):
             def __init__(self, *args, **kwargs):
                 super().__init__(*args, directory=str(root), **kwargs)
+
+            def do_GET(self):  # noqa: N802 (http.server's name)
+                route = routes.get(self.path.split("?", 1)[0])
+                if route is None:
+                    super().do_GET()
+                    return
+                body = json.dumps(route()).encode()
+                self.send_response(200)
+                self.send_header("Content-Type", "application/json")
+                self.send_header("Content-Length", str(len(body)))
+                self.end_headers()
+                self.wfile.write(body)
 
             def do_POST(self):  # noqa: N802 (http.server's name)
                 body = self.rfile.read(int(self.headers["Content-Length"]))
@@ -196,32 +233,65 @@ class Server:
         self.httpd.shutdown()
 
 
+def signed_fold_angles(creases, positions) -> np.ndarray:
+    """(C,) fold angle in radians of each crease row ``[edge node 0, edge node 1,
+    node 1, node 2, ...]`` (Origami Simulator's ``Crease``: nodes 1 and 2 are the
+    triangles' tips on either side of the edge) at ``positions`` ((N, 3) or flat).
+
+    Origami Simulator's own dihedral angle (its ``thetaCalc`` shader): atan2 of
+    ((n1 × e) · n2, n1 · n2) with e the edge from node 0 to node 1 and n1, n2 the
+    triangles' normals. The normals here are built from the nodes (n1 = e × (p − a),
+    n2 = (q − a) × e), which turns both of a consistently oriented pair alike
+    whichever side node 1 lies on, so the angle is the app's, sign included: its
+    targets are FOLD's (valley positive), so is this. In (−π, π]: the app's own
+    angle is unwrapped past ±π, a position cannot tell."""
+    x = np.asarray(positions, dtype=float).reshape(-1, 3)
+    c = np.asarray(creases, dtype=float)
+    if c.size == 0:
+        return np.zeros(0)
+    a, b, p, q = (x[c[:, k].astype(int)] for k in range(4))
+    e = b - a
+    n1, n2 = np.cross(e, p - a), np.cross(q - a, e)
+    e_unit = e / np.linalg.norm(e, axis=1, keepdims=True)
+    sine = np.einsum("ij,ij->i", np.cross(n1, e_unit), n2)
+    return np.arctan2(sine, np.einsum("ij,ij->i", n1, n2))
+
+
 def crease_angle_errors(result: dict, positions) -> np.ndarray:
     """(C,) |fold angle − |target|| in degrees of every M/V crease (type 1) at
     ``positions`` (flat list, 3 per node), fold angle = angle between its two
     triangles' normals (0 flat)."""
-    x = np.asarray(positions, dtype=float).reshape(-1, 3)
     c = np.array([row for row in result["creases"] if row[5] == 1], dtype=float)
-    a, b, p, q = (x[c[:, k].astype(int)] for k in range(4))
-    d = b - a
-    n1, n2 = np.cross(d, p - a), np.cross(q - a, d)
-    angle = np.arctan2(np.linalg.norm(np.cross(n1, n2), axis=1), np.einsum("ij,ij->i", n1, n2))
+    angle = np.abs(signed_fold_angles(c, positions))
     return np.abs(np.degrees(angle) - np.degrees(np.abs(c[:, 4])))
+
+
+def launch(url: str, profile: Path) -> subprocess.Popen:
+    """Headless Chromium (``FLAGS``, profile folder ``profile``) on ``url``."""
+    return subprocess.Popen([CHROMIUM, *FLAGS, f"--user-data-dir={profile}", url],
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+
+
+def close(browser: subprocess.Popen) -> None:
+    """End a browser ``launch`` started (and wait for it)."""
+    browser.terminate()
+    try:
+        browser.wait(timeout=30)
+    except subprocess.TimeoutExpired:
+        browser.kill()
+        browser.wait(timeout=30)
 
 
 def run_origami_simulator(root: Path, profile: Path) -> dict:
     """One Origami Simulator fold in a fresh Chromium (module docstring)."""
     server = Server(root)
-    url = f"http://127.0.0.1:{server.port}/{HARNESS_PAGE}?model={MODEL}"
-    browser = subprocess.Popen([CHROMIUM, *FLAGS, f"--user-data-dir={profile}", url],
-                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    browser = launch(f"http://127.0.0.1:{server.port}/{HARNESS_PAGE}?model={MODEL}", profile)
     try:
         result = server.results.get(timeout=PAGE_TIMEOUT_S)
     except queue.Empty:
         raise SystemExit(f"origami_simulator: no result from the page in {PAGE_TIMEOUT_S:.0f} s")
     finally:
-        browser.terminate()
-        browser.wait(timeout=30)
+        close(browser)
         server.close()
     if "error" in result:
         raise SystemExit(f"origami_simulator: the page failed: {result['error']}")
