@@ -115,6 +115,7 @@ def one_file(path: Path, svgs: Path, runs: int) -> dict:
     row = {"svg": state["svg"], "nodes": int(len(state.get("nodes", []))), "folds": []}
     if "error" in state:
         return {**row, "os_error": state["error"]}
+    row["ties_through_lowest"], row["ties_otherwise"] = tied_quadrilaterals(state)
     svg = svgs / state["svg"]
     try:
         mesh_pattern = pattern_of_mesh(state)
@@ -159,6 +160,32 @@ def cli_seconds(svg: Path) -> float:
         return time.perf_counter() - t0
 
 
+def tied_quadrilaterals(state: dict) -> tuple[int, int]:
+    """(cut through their lowest vertex id, cut otherwise): Origami Simulator's
+    quadrilaterals whose diagonals tie (within ``foldcore.sheet.build.TIE``), from
+    its faces before and after it cut them."""
+    from foldcore.sheet.build import TIE
+
+    raw = state.get("fold_raw", {})
+    if "faces_vertices" not in raw:
+        return 0, 0
+    xy = raw["vertices_coords"][:, [0, 2]]
+    cut = {tuple(sorted(t)) for t in np.asarray(state["faces"]).tolist()}
+    through, other = 0, 0
+    for face in raw["faces_vertices"]:
+        if len(face) != 4:
+            continue
+        p = xy[face]
+        d02, d13 = np.sum((p[0] - p[2]) ** 2), np.sum((p[1] - p[3]) ** 2)
+        if abs(d02 - d13) > TIE * max(d02, d13):
+            continue
+        lowest = int(np.argmin(face))
+        tri = sorted((face[lowest], face[(lowest + 1) % 4], face[(lowest + 2) % 4]))
+        through += tuple(tri) in cut
+        other += tuple(tri) not in cut
+    return through, other
+
+
 def totals(rows: list[dict]) -> dict:
     """The library in numbers: files read, matched, compared; shape differences and
     time ratios over every settled fold (medians, largest, counts)."""
@@ -166,7 +193,9 @@ def totals(rows: list[dict]) -> dict:
     out = {"files": len(rows), "os_read": sum("os_error" not in r for r in rows),
            "foldcore_read": sum("read_error" not in r and "os_error" not in r for r in rows),
            "matched": sum(r.get("matched", False) for r in rows),
-           "settled_folds": len(folds)}
+           "settled_folds": len(folds),
+           "ties_through_lowest": sum(r.get("ties_through_lowest", 0) for r in rows),
+           "ties_otherwise": sum(r.get("ties_otherwise", 0) for r in rows)}
     for kind in ("model", "end_to_end"):
         done = [f for f in folds if kind in f]
         if not done:
@@ -195,7 +224,9 @@ def table(data: dict) -> str:
     t = data["totals"]
     lines = [f"{t['files']} SVGs; Origami Simulator read {t['os_read']}, foldcore "
              f"{t['foldcore_read']}, the two readers' vertices matched on {t['matched']}; "
-             f"{t['settled_folds']} folds (file × percent) where Origami Simulator settled.", ""]
+             f"{t['settled_folds']} folds (file × percent) where Origami Simulator settled; "
+             f"of its quadrilaterals with tied diagonals, {t['ties_through_lowest']} cut "
+             f"through their lowest vertex id, {t['ties_otherwise']} otherwise.", ""]
     header = ["comparison", "folds", "median largest Δφ", "within 1°", "converged",
               "median speed-up vs OS", "slower than OS", "over 10 s (largest)"]
     body = []
