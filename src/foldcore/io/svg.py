@@ -20,9 +20,11 @@ Colours are matched as Origami Simulator matches them (``#f00``, ``red``,
 ``rgb(255,0,0)`` alike, after CSS and presentation attributes: svgelements
 computes styles, transforms and the viewBox). Strokes of other colours, and
 shapes without a stroke, are ignored as Origami Simulator ignores them, said
-once with a count. Curved segments are refused (panels are planar): an SVG
-path's Bézier or arc segment whose control points are off its chord by more
-than 1e-4 of its chord names its element.
+once with a count. A path's Bézier or arc segment off its chord by more than
+1e-4 of it is a curved crease: read as a polyline within ``CURVE_SAG_PX`` of
+the curve (its pieces at least ``SNAP_PX`` long, at most 64 per segment), said
+once with a count; a thin sheet folds it with bending facets, as Origami
+Simulator folds its curved patterns.
 
 Planarisation (:mod:`.lines`, shapely) at ``SNAP_PX`` = 3 px (Origami
 Simulator's vertex tolerance; at most 1 % of the sheet): endpoints that near
@@ -59,6 +61,11 @@ SNAP_MAX = 1e-2
 #: A Bézier or arc segment is straight if its points are off its chord by at most this
 #: share of the chord (Illustrator exports round coordinates to 1e-3 px).
 STRAIGHT = 1e-4
+#: A curved segment is read as a polyline within this distance of the curve, px (a
+#: third of the merge distance SNAP_PX) ...
+CURVE_SAG_PX = 1.0
+#: ... halving its parameter range at most this many times (2⁶ = 64 pieces).
+CURVE_DEPTH = 6
 #: Stroke (r, g, b) → (assignment, sign of the target: -1 mountain, +1 valley, 0 none).
 STROKES = {(0, 0, 0): ("B", 0.0), (255, 0, 0): ("M", -1.0), (0, 0, 255): ("V", 1.0),
            (255, 255, 0): ("F", 0.0), (255, 0, 255): ("U", 0.0), (0, 255, 0): ("C", 0.0)}
@@ -85,8 +92,8 @@ def read_svg(path, reading: Reading | None = None) -> CreasePattern:
     Raises
     ------
     PatternError
-        Not an SVG, no creases, a cut, a curved segment, conflicting types on one
-        segment, or a malformed pattern (named as :class:`CreasePattern` names it).
+        Not an SVG, no creases, a cut, conflicting types on one segment, or a
+        malformed pattern (named as :class:`CreasePattern` names it).
     """
     source = os.fspath(path)
     reading = Reading() if reading is None else reading
@@ -107,7 +114,7 @@ def read_svg(path, reading: Reading | None = None) -> CreasePattern:
 def _strokes(source: str):
     """(S, 2, 2) straight segments (px), their assignment, target (degrees or NaN) and
     the element each came from (for messages)."""
-    segments, kinds, angles, owners, ignored = [], [], [], [], {}
+    segments, kinds, angles, owners, ignored, curves = [], [], [], [], {}, []
     for number, element in enumerate(_shapes(source)):
         name = _element_name(element, number)
         kind, sign = _stroke_type(element)
@@ -123,7 +130,7 @@ def _strokes(source: str):
         angle = sign * 180.0 * _opacity(element, name, source) if sign \
             else (0.0 if kind == "F" else np.nan)
         try:
-            found = _element_segments(element, name, source)
+            found = _element_segments(element, name, source, curves)
         except PatternError:
             raise
         except _SVG_FAILURES as exc:
@@ -136,6 +143,9 @@ def _strokes(source: str):
         if len(segments) > MAX_SEGMENTS:
             raise PatternError(f"{source}: more than {MAX_SEGMENTS} straight segments "
                                f"(at {name})")
+    if curves:
+        note(source, f"{len(curves)} curved segments read as {sum(curves)} straight "
+                     f"pieces, within {CURVE_SAG_PX:g} px of the curves")
     if ignored:
         counts = ", ".join(f"{n} {c}" for c, n in sorted(ignored.items()))
         note(source, f"{sum(ignored.values())} shapes whose stroke is none of Origami "
@@ -160,11 +170,13 @@ def _shapes(source: str) -> list:
         raise PatternError(f"{source}: not a readable SVG ({_failure(exc)})") from None
 
 
-def _element_segments(element, name: str, source: str) -> list:
+def _element_segments(element, name: str, source: str, curves: list) -> list:
     """[((x0, y0), (x1, y1))] the straight segments (px) of one stroked shape, its
-    transform applied; refused naming the element where a geometric attribute is
-    not a finite number (svgelements would read it as 0) or the transform is
-    singular or not finite (a ``scale(0)`` would make its creases vanish)."""
+    transform applied, a curved segment as a polyline (:func:`_polyline`; its piece
+    count appended to ``curves``); refused naming the element where a geometric
+    attribute is not a finite number (svgelements would read it as 0) or the
+    transform is singular or not finite (a ``scale(0)`` would make its creases
+    vanish)."""
     from svgelements import Close, Line, Move, Path
 
     _check_geometry(element, name, source)
@@ -182,11 +194,43 @@ def _element_segments(element, name: str, source: str) -> list:
             continue
         a = _point(seg.start, name, source)
         b = _point(seg.end, name, source)
-        if not isinstance(seg, (Line, Close)):
-            _check_straight(seg, np.array(a), np.array(b), name, source)
-        if a != b:
-            out.append((a, b))
+        if isinstance(seg, (Line, Close)) or _straight(seg, np.array(a), np.array(b),
+                                                       name, source):
+            if a != b:
+                out.append((a, b))
+            continue
+        points = _polyline(seg, name, source)
+        out += [(p, q) for p, q in zip(points[:-1], points[1:]) if p != q]
+        curves.append(len(points) - 1)
+        if len(out) > MAX_SEGMENTS:
+            raise PatternError(f"{source}: more than {MAX_SEGMENTS} straight segments "
+                               f"(at {name}, its curves read as polylines)")
     return out
+
+
+def _polyline(seg, name: str, source: str) -> list:
+    """A curved segment as a polyline: its parameter range halved until each piece's
+    curve lies within :data:`CURVE_SAG_PX` of its chord (checked at its quarter
+    points), or the piece is shorter than :data:`SNAP_PX` (it would be merged),
+    at most :data:`CURVE_DEPTH` halvings; [(x, y)] px from start to end."""
+    def at(t):
+        return np.array(_point(seg.point(t), name, source))
+
+    def pieces(t0, t1, p0, p1, depth):
+        ts = [t0 + (t1 - t0) * f for f in (0.25, 0.5, 0.75)]
+        mids = [at(t) for t in ts]
+        chord = p1 - p0
+        length = float(np.hypot(*chord))
+        sag = max(abs(float(chord[0] * (m - p0)[1] - chord[1] * (m - p0)[0]))
+                  / max(length, 1e-300) if length else float(np.hypot(*(m - p0)))
+                  for m in mids)
+        if depth >= CURVE_DEPTH or sag <= CURVE_SAG_PX or length <= SNAP_PX:
+            return [p1]
+        return (pieces(t0, ts[1], p0, mids[1], depth + 1)
+                + pieces(ts[1], t1, mids[1], p1, depth + 1))
+
+    start = at(0.0)
+    return [tuple(map(float, p)) for p in [start] + pieces(0.0, 1.0, start, at(1.0), 0)]
 
 
 def _check_geometry(element, name: str, source: str) -> None:
@@ -260,18 +304,16 @@ def _opacity(element, name: str, source: str) -> float:
     return float(np.clip(number("opacity", 1.0) * stroke, 0.0, 1.0))
 
 
-def _check_straight(seg, a: np.ndarray, b: np.ndarray, name: str, source: str) -> None:
-    """A Bézier or arc segment from ``a`` to ``b`` (px, its checked ends) is read as
-    its chord only if it is one (its points at a few parameters lie on the chord)."""
+def _straight(seg, a: np.ndarray, b: np.ndarray, name: str, source: str) -> bool:
+    """Whether a Bézier or arc segment from ``a`` to ``b`` (px, its checked ends) is
+    its chord (its points at a few parameters lie on it within :data:`STRAIGHT`)."""
     chord = b - a
     length = float(np.hypot(*chord))
     for t in (0.25, 0.5, 0.75):
         d = np.array(_point(seg.point(t), name, source)) - a
         off = abs(float(chord[0] * d[1] - chord[1] * d[0])) / max(length, 1e-300)
-        if off > STRAIGHT * length:
-            raise PatternError(f"{source}: {name} has a curved segment "
-                               f"({type(seg).__name__} from ({a[0]:g}, {a[1]:g}) to "
-                               f"({b[0]:g}, {b[1]:g})); foldcore's panels are planar: "
-                               "draw creases as straight lines")
+        if off > STRAIGHT * length or not length and np.hypot(*d) > 0.0:
+            return False
+    return True
 
 
