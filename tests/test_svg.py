@@ -106,6 +106,25 @@ def test_a_curved_crease_is_read_as_a_polyline_within_its_tolerance(tmp_path):
     assert gap.max() <= CURVE_SAG_PX + nearest.max()  # the sag, and the joints' snapping
 
 
+def test_lines_whose_type_contradicts_their_sides_are_read_as_origami_simulator_reads_them(
+        tmp_path):
+    """A red line along the sheet's edge has no face to fold against: boundary. A
+    black line across the sheet has faces on both sides: a free hinge (U)."""
+    body = ('<polyline points="100,0 100,100 0,100 0,0" fill="none" stroke="#000"/>'
+            '<line x1="0" y1="0" x2="100" y2="0" stroke="#f00"/>'        # the top edge
+            '<line x1="50" y1="0" x2="50" y2="100" stroke="#000"/>'      # across
+            '<line x1="0" y1="50" x2="50" y2="50" stroke="#00f"/>')
+    pattern, notes = read_text(tmp_path, svg(body))
+    kinds = dict(zip(map(tuple, np.round(pattern.vertices[pattern.edges].mean(axis=1)
+                                         / MM_PER_PX).astype(int).tolist()),
+                     pattern.assignments))
+    assert kinds[(25, 0)] == kinds[(75, 0)] == "B"          # the red line: boundary
+    assert kinds[(50, -25)] == kinds[(50, -75)] == "U"      # the black line: free hinge
+    assert kinds[(25, -50)] == "V"
+    assert any("read as boundary, as Origami Simulator reads them" in n for n in notes)
+    assert any("read as free hinges (U)" in n for n in notes)
+
+
 @pytest.mark.parametrize("body, needles", [
     ('<line x1="50" y1="0" x2="50" y2="100" stroke="#0f0"/>', ["line", "cut"]),
     ('<line x1="50" y1="0" x2="50" y2="100" stroke="#f00"/>'

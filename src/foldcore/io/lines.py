@@ -17,6 +17,7 @@ import numpy as np
 
 from ..errors import PatternError
 from ..pattern import CreasePattern
+from .conventions import note
 
 #: Most pairs of segments that meet or cross (each a vertex to node; Origami
 #: Simulator's library has at most 16 782, and noding 10⁵ takes about 2 s).
@@ -30,7 +31,8 @@ PARALLEL = 0.1
 
 
 def pattern_from_lines(segments: np.ndarray, kinds, angles, owners, source: str, *,
-                       tol: float, factor: float = 1.0, where=None) -> CreasePattern:
+                       tol: float, factor: float = 1.0, where=None,
+                       sides_as_origami_simulator: bool = False) -> CreasePattern:
     """The crease pattern of a line drawing (module docstring).
 
     Parameters
@@ -47,13 +49,53 @@ def pattern_from_lines(segments: np.ndarray, kinds, angles, owners, source: str,
         mm per file unit.
     where : callable(x, y) -> str, optional
         A place in the file's words, for messages (default ``(x, y)``).
+    sides_as_origami_simulator : bool
+        Lines whose type contradicts their sides read as Origami Simulator reads
+        them (:func:`sides_read_as_origami_simulator`) instead of refused.
     """
     vertices, edges, pieces = planarise(segments, tol, source)
     extra = {} if where is None else {"where": where}
     assignments, fold_angles = piece_types(pieces, edges, vertices, segments, kinds,
                                            angles, owners, tol, source, **extra)
+    if sides_as_origami_simulator:
+        assignments, fold_angles = sides_read_as_origami_simulator(
+            vertices, edges, assignments, fold_angles, source)
     return CreasePattern(vertices * factor, edges, assignments, fold_angles=fold_angles,
                          source=source)
+
+
+def sides_read_as_origami_simulator(vertices, edges, assignments, fold_angles, source: str):
+    """(assignments, fold_angles) with the lines whose type contradicts their sides read
+    as Origami Simulator reads them, each kind said once with a count: a crease (M, V,
+    F, U) with the sheet on one side only is boundary (B: no face to fold against),
+    a boundary line (B) with the sheet on both sides is a free hinge (U: a bar
+    without a spring)."""
+    from ..planar import derive_face_loops
+
+    assignments = np.array(assignments, dtype="<U1")
+    fold_angles = np.array(fold_angles, dtype=float)
+    flat, lengths = derive_face_loops(vertices, edges, assignments == "B", source)
+    following = np.arange(len(flat)) + 1
+    starts = np.concatenate([[0], np.cumsum(lengths)[:-1]])
+    following[starts + lengths - 1] = starts
+    n = len(vertices)
+    edge_keys = np.minimum(edges[:, 0], edges[:, 1]) * n + np.maximum(edges[:, 0], edges[:, 1])
+    side_keys = np.minimum(flat, flat[following]) * n + np.maximum(flat, flat[following])
+    by_key = np.argsort(edge_keys)
+    per_edge = np.bincount(by_key[np.searchsorted(edge_keys[by_key], side_keys)],
+                           minlength=len(edges))
+    lone = np.flatnonzero((per_edge == 1) & (assignments != "B"))
+    inner = np.flatnonzero((per_edge == 2) & (assignments == "B"))
+    if len(lone):
+        note(source, f"{len(lone)} creases with the sheet on one side only (edge "
+                     f"{int(lone[0])}, …) read as boundary, as Origami Simulator reads them")
+        assignments[lone], fold_angles[lone] = "B", np.nan
+    if len(inner):
+        note(source, f"{len(inner)} boundary lines with the sheet on both sides (edge "
+                     f"{int(inner[0])}, …) read as free hinges (U), as Origami Simulator "
+                     "folds them")
+        assignments[inner], fold_angles[inner] = "U", np.nan
+    return assignments, fold_angles
 
 
 def check_meetings(segments: np.ndarray, source: str) -> None:

@@ -32,7 +32,10 @@ another segment are moved onto it (T-joins drawn a little short or long), the
 segments are noded — every crossing and overlap becomes a shared vertex —
 and vertices that near are merged (an overlapped piece is one edge). Each
 piece takes the type of the segments it lies on; two different types on one
-piece are refused, naming both elements.
+piece are refused, naming both elements. A line whose type contradicts its
+sides is read as Origami Simulator reads it, said once with a count: a crease
+with the sheet on one side only is boundary, a boundary line with the sheet on
+both sides a free hinge (``U``).
 
 Lengths: SVG user units are CSS pixels, 1 px = 25.4 / 96 mm; ``Reading.scale``
 or ``Reading.size`` rescale. y is flipped (SVG's y points down), so the
@@ -108,7 +111,8 @@ def read_svg(path, reading: Reading | None = None) -> CreasePattern:
     return pattern_from_lines(segments, kinds, angles, owners, source,
                               tol=min(SNAP_PX, SNAP_MAX * extent),
                               factor=reading.factor(extent * MM_PER_PX) * MM_PER_PX,
-                              where=lambda x, y: f"({x:g}, {-y:g}) px")
+                              where=lambda x, y: f"({x:g}, {-y:g}) px",
+                              sides_as_origami_simulator=True)
 
 
 def _strokes(source: str):
