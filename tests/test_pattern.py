@@ -225,20 +225,20 @@ def test_vertex_with_nonzero_z():
 
 
 def test_disconnected_pattern_derived_faces():
-    # a second square (vertices 6..9, edges 7..10) far away
+    # a second square (vertices 6..9, edges 7..10) far away: two pieces, faces for both
     v = SQ_V + [(40, 0), (50, 0), (50, 10), (40, 10)]
     e = SQ_E + [(6, 7), (7, 8), (8, 9), (9, 6)]
-    msg = refused("(?:vertex|edge)", r"(?:[6-9]|10)", vertices=v, edges=e,
-                  assignments=SQ_A + ["B"] * 4)
-    assert "connect" in msg
+    pattern = make(vertices=v, edges=e, assignments=SQ_A + ["B"] * 4)
+    assert pattern.pieces == 2
+    assert sorted(map(sorted, pattern.faces))[-1] == [6, 7, 8, 9]
 
 
 def test_disconnected_pattern_given_faces():
     v = SQ_V + [(40, 0), (50, 0), (50, 10), (40, 10)]
     e = SQ_E + [(6, 7), (7, 8), (8, 9), (9, 6)]
-    msg = refused("(?:vertex|edge)", r"(?:[6-9]|10)", vertices=v, edges=e,
-                  assignments=SQ_A + ["B"] * 4, faces=SQ_F + [[6, 7, 8, 9]])
-    assert "connect" in msg
+    pattern = make(vertices=v, edges=e, assignments=SQ_A + ["B"] * 4,
+                   faces=SQ_F + [[6, 7, 8, 9]])
+    assert pattern.pieces == 2 and len(pattern.faces) == len(SQ_F) + 1
 
 
 def test_disconnected_pattern_nested_in_hole():
@@ -248,7 +248,7 @@ def test_disconnected_pattern_nested_in_hole():
     e = e + [(8, 9), (9, 10), (10, 11), (11, 8)]
     msg = refused("(?:vertex|edge)", r"(?:8|9|1[0-5])", vertices=v, edges=e,
                   assignments=a + ["B"] * 4)
-    assert "connect" in msg
+    assert "inside another piece" in msg
 
 
 # ---------------------------------------------------- malformed edge data
@@ -422,13 +422,29 @@ def test_creased_pieces_pinned_at_a_vertex_are_refused_naming_it():
     assert "faces meet only at this vertex" in msg
 
 
-def test_separate_pieces_are_refused_like_a_bow_tie():
-    """Two pieces apart and two pieces at one vertex: both one line, the same advice."""
+def test_separate_pieces_are_a_pattern_that_a_thick_sheet_refuses_naming_a_vertex():
+    """Two pieces apart: a pattern (a thin sheet folds both, as Origami Simulator
+    does); a thick sheet needs one piece and says which vertex is not connected."""
+    from foldcore import thicken
+
     vertices = PINNED_V[:4] + [(x + 30.0, y) for x, y in PINNED_V[4:]] + [(30.0, 0.0)]
     edges = [(7 if (u == 0 and i >= 5) else u, 7 if (v == 0 and i >= 5) else v)
              for i, (u, v) in enumerate(PINNED_E)]
-    msg = refused("vertex", 4, vertices=vertices, edges=edges, assignments=PINNED_A)
-    assert "not connected (2 separate pieces)" in msg and "simulate each piece on its own" in msg
+    pattern = make(vertices=vertices, edges=edges, assignments=PINNED_A)
+    assert pattern.pieces == 2 and len(pattern.faces) == 4   # two creased squares
+    with pytest.raises(PatternError) as info:
+        thicken(pattern, 1.0)
+    msg = str(info.value)
+    assert "not connected (2 separate pieces)" in msg and "vertex 4" in msg
+    assert "simulate each piece on its own" in msg and "thin sheet" in msg
+
+
+def test_a_piece_drawn_inside_another_is_refused_naming_a_vertex():
+    outer = [(0, 0), (10, 0), (10, 10), (0, 10)]
+    inner = [(4, 4), (6, 4), (6, 6), (4, 6)]
+    edges = [(0, 1), (1, 2), (2, 3), (3, 0), (4, 5), (5, 6), (6, 7), (7, 4)]
+    msg = refused("vertex", 4, vertices=outer + inner, edges=edges, assignments=["B"] * 8)
+    assert "inside another piece" in msg
 
 
 def test_a_boundary_vertex_with_one_fan_is_one_sheet():

@@ -173,19 +173,25 @@ class CreasePattern:
             self._fail(f"edges {i} and {j} cross or overlap")
 
     def _validate_connected(self):
+        """Count the separate pieces (:attr:`pieces`); a thick sheet needs one
+        (:meth:`check_one_piece`), a thin sheet folds them all."""
         from scipy.sparse import coo_matrix
         from scipy.sparse.csgraph import connected_components
 
         n = self.n_vertices
         graph = coo_matrix((np.ones(self.n_edges), (self.edges[:, 0], self.edges[:, 1])),
                            shape=(n, n))
-        n_pieces, label = connected_components(graph, directed=False)
-        if n_pieces > 1:
-            v = int(np.flatnonzero(label != label[0])[0])
+        self.pieces, self._piece_of = connected_components(graph, directed=False)
+
+    def check_one_piece(self, what: str = "a thick sheet") -> None:
+        """PatternError naming a vertex of a second piece when the pattern is several."""
+        if self.pieces > 1:
+            v = int(np.flatnonzero(self._piece_of != self._piece_of[0])[0])
             e = int(np.flatnonzero((self.edges == v).any(axis=1))[0])
-            self._fail(f"the pattern is not connected ({n_pieces} separate pieces): vertex "
-                       f"{v} (edge {e}) is not connected to vertex 0; simulate each piece "
-                       "on its own")
+            self._fail(f"the pattern is not connected ({self.pieces} separate pieces): vertex "
+                       f"{v} (edge {e}) is not connected to vertex 0; {what} needs one "
+                       "piece: simulate each piece on its own, or fold it as a thin sheet "
+                       "(no thickness)")
 
     def _validate_edge_values(self):
         kind, angle = self.assignments, self.fold_angles

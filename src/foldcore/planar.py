@@ -321,10 +321,8 @@ def derive_face_loops(vertices: np.ndarray, edges: np.ndarray, boundary: np.ndar
     """:func:`derive_faces` as (N,) concatenated vertex ids and (F,) loop lengths."""
     corners, halfedges, lengths = face_cycles(vertices, edges)
     areas = signed_areas(vertices, corners, lengths)
-    n_outer = np.count_nonzero(areas < 0)
-    if n_outer > 1:
-        raise PatternError(f"{source}: the pattern is not connected "
-                           f"({n_outer} separate pieces); simulate each piece on its own")
+    if np.count_nonzero(areas < 0) > 1:
+        _check_pieces_apart(vertices, corners, lengths, areas, source)
     edge_of = halfedges % max(len(edges), 1)
     cycle_of = np.repeat(np.arange(len(lengths)), lengths)
     outer = np.zeros(len(edges), dtype=bool)
@@ -334,6 +332,20 @@ def derive_face_loops(vertices: np.ndarray, edges: np.ndarray, boundary: np.ndar
     is_hole = np.bincount(cycle_of, weights=not_hole_side, minlength=len(lengths)) == 0
     keep = (areas > 0) & ~is_hole
     return corners[keep[cycle_of]], lengths[keep]
+
+
+def _check_pieces_apart(vertices, corners, lengths, areas, source: str) -> None:
+    """PatternError naming a vertex of a piece that lies inside another piece's
+    outline (sheets drawn over each other), for a pattern of several pieces."""
+    from shapely import Polygon, points, contains
+
+    outlines = [loop for loop, a in zip(split_loops(corners, lengths), areas) if a < 0]
+    for i, outline in enumerate(outlines):
+        others = np.setdiff1d(np.concatenate(outlines[:i] + outlines[i + 1:]), outline)
+        inside = others[contains(Polygon(vertices[outline]), points(vertices[others]))]
+        if len(inside):
+            raise PatternError(f"{source}: vertex {int(inside[0])} lies inside another piece "
+                               "(pieces drawn over each other, or an unjoined hole)")
 
 
 def crossing_pairs(vertices: np.ndarray, edges: np.ndarray) -> list[tuple[int, int]]:

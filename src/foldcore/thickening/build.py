@@ -103,6 +103,7 @@ class _Sheet(NamedTuple):
 def _resolve(pattern, thickness, hinge_width, subdivisions, bend_radius, hinge, stiffness,
              stretch) -> _Sheet:
     """Check ``thicken``'s arguments and resolve widths, hinge models and sub-strips."""
+    pattern.check_one_piece()
     check_thickness(pattern, thickness)
     check_stiffness(pattern, stiffness)
     widths = resolve_widths(pattern, thickness, hinge_width, bend_radius)
