@@ -545,9 +545,10 @@ def summary_row(job: dict, state: dict, busy: dict, folds: list) -> dict:
                                       "largest_move", "largest_shape_move",
                                       "final_strain")}
         log = np.asarray(raw.get("log") or np.zeros((0, 5)), dtype=float)
-        if len(log):  # [steps, largest move, largest shape move], thinned to ~20 rows
-            pick = np.unique(np.linspace(0, len(log) - 1, min(len(log), 20)).astype(int))
-            keep["moves"] = [[int(log[i, 0]), float(log[i, 3]), float(log[i, 4])] for i in pick]
+        if len(log):  # [steps, largest move, largest shape move], thinned to ~10 rows
+            pick = np.unique(np.linspace(0, len(log) - 1, min(len(log), 10)).astype(int))
+            keep["moves"] = [[int(log[i, 0]), float(f"{log[i, 3]:.3g}"), float(f"{log[i, 4]:.3g}")]
+                             for i in pick]
         row["folds"].append(keep)
     return row
 
@@ -688,7 +689,7 @@ def main() -> None:
         start = time.perf_counter()
         rows = run_library(root, jobs, commit, cfg, states, tmp)
     record.meta["wall_seconds"] = time.perf_counter() - start
-    record.write({"files": rows, "totals": totals(rows, cfg["percents"])})
+    record.write({"files": rows, "totals": totals(rows, cfg["percents"])}, indent=None)
     print(table({"meta": record.meta, "files": rows}))
 
 
@@ -721,8 +722,12 @@ def table(out: dict) -> str:
         fmt = (lambda x: "–" if x is None else f"{x:.2f}")
         rows.append([f"{percent} %", f"{v['folds']}", f"{v['reached_a']}", fmt(v["median_a_seconds"]),
                      f"{v['settled']}", fmt(v["median_b_seconds_settled"])])
+    busy = [r["others_busy"] for r in out["files"] if "others_busy" in r]
     head = (f"{t['read']} of {t['files']} files read"
-            + (f" (failed: {', '.join(t['failed'])})" if t["failed"] else ""))
+            + (f" (failed: {', '.join(t['failed'])})" if t["failed"] else "")
+            + f"; stepping capped at {out['meta']['harness']['limit_s']:g} s per fold"
+            + (f"; other jobs used a median {statistics.median(busy):.0%} of the cores"
+               if busy else ""))
     return head + "\n\n" + _meta.markdown_table(
         ["fold", "folds run", "(a) reached", "(a) median s", "(b) settled",
          "(b) median s (settled)"], rows)
