@@ -406,8 +406,9 @@ def load_state(path) -> dict:
     positions in the app's normalised frame, ``faces`` (F, 3), ``beams`` (E, 2),
     ``creases`` (C, 8) float rows [edge node 0, edge node 1, node 1, node 2,
     target (rad), type, face 1, face 2], ``center`` (3,), FOLD arrays of ``fold``
-    and ``fold_raw`` (vertices_coords, edges_vertices; assignments as lists, fold
-    angles as float arrays with NaN for none), and per entry of ``folds`` (one per
+    and ``fold_raw`` (vertices_coords, edges_vertices, ``fold``'s faces_vertices:
+    the model's beams and faces; assignments as lists, fold angles as float
+    arrays with NaN for none), and per entry of ``folds`` (one per
     percent) ``positions_a`` / ``positions_b`` (N, 3) or None."""
     with gzip.open(path, "rt") as fh:
         state = json.load(fh)
@@ -416,6 +417,11 @@ def load_state(path) -> dict:
     for key, dtype in (("nodes", float), ("faces", int), ("beams", int), ("creases", float),
                        ("center", float)):
         state[key] = np.asarray(state[key], dtype=dtype)
+    # the FOLD data's edges and faces, stored once as the model's beams and triangles
+    if state.pop("fold_edges_are_beams", False):
+        state["fold"]["edges_vertices"] = state["beams"]
+    if state.pop("fold_faces_are_faces", False):
+        state["fold"]["faces_vertices"] = state["faces"]
     for key in ("fold", "fold_raw"):
         fold = state.get(key, {})
         for name, dtype in (("vertices_coords", float), ("edges_vertices", int)):
@@ -515,14 +521,6 @@ def state_of(job: dict, model: dict, folds: list, commit: str) -> dict:
             "final_strain": b["strain"],
             "positions_a": a and triples(a["positions"]), "positions_b": triples(b["positions"])})
     return state
-
-
-def restore(state: dict) -> None:
-    """Put back what ``state_of`` stored once (in place, on the JSON dict)."""
-    if state.pop("fold_edges_are_beams", False):
-        state["fold"]["edges_vertices"] = state["beams"]
-    if state.pop("fold_faces_are_faces", False):
-        state["fold"]["faces_vertices"] = state["faces"]
 
 
 def summary_row(job: dict, state: dict, busy: dict, folds: list) -> dict:
