@@ -406,8 +406,9 @@ def load_state(path) -> dict:
     positions in the app's normalised frame, ``faces`` (F, 3), ``beams`` (E, 2),
     ``creases`` (C, 8) float rows [edge node 0, edge node 1, node 1, node 2,
     target (rad), type, face 1, face 2], ``center`` (3,), FOLD arrays of ``fold``
-    and ``fold_raw`` (vertices_coords, edges_vertices; assignments as lists, fold
-    angles as float arrays with NaN for none), and per entry of ``folds`` (one per
+    and ``fold_raw`` (vertices_coords, edges_vertices, ``fold``'s faces_vertices:
+    the model's beams and faces; assignments as lists, fold angles as float
+    arrays with NaN for none), and per entry of ``folds`` (one per
     percent) ``positions_a`` / ``positions_b`` (N, 3) or None."""
     with gzip.open(path, "rt") as fh:
         state = json.load(fh)
@@ -416,6 +417,11 @@ def load_state(path) -> dict:
     for key, dtype in (("nodes", float), ("faces", int), ("beams", int), ("creases", float),
                        ("center", float)):
         state[key] = np.asarray(state[key], dtype=dtype)
+    # the FOLD data's edges and faces, stored once as the model's beams and triangles
+    if state.pop("fold_edges_are_beams", False):
+        state["fold"]["edges_vertices"] = state["beams"]
+    if state.pop("fold_faces_are_faces", False):
+        state["fold"]["faces_vertices"] = state["faces"]
     for key in ("fold", "fold_raw"):
         fold = state.get(key, {})
         for name, dtype in (("vertices_coords", float), ("edges_vertices", int)):
@@ -517,14 +523,6 @@ def state_of(job: dict, model: dict, folds: list, commit: str) -> dict:
     return state
 
 
-def restore(state: dict) -> None:
-    """Put back what ``state_of`` stored once (in place, on the JSON dict)."""
-    if state.pop("fold_edges_are_beams", False):
-        state["fold"]["edges_vertices"] = state["beams"]
-    if state.pop("fold_faces_are_faces", False):
-        state["fold"]["faces_vertices"] = state["faces"]
-
-
 def summary_row(job: dict, state: dict, busy: dict, folds: list) -> dict:
     row = {"svg": job["svg"], "loader": state.get("loader"), "in_menu": job["in_menu"],
            "load_seconds": state.get("load_seconds"), **busy}
@@ -545,9 +543,10 @@ def summary_row(job: dict, state: dict, busy: dict, folds: list) -> dict:
                                       "largest_move", "largest_shape_move",
                                       "final_strain")}
         log = np.asarray(raw.get("log") or np.zeros((0, 5)), dtype=float)
-        if len(log):  # [steps, largest move, largest shape move], thinned to ~20 rows
-            pick = np.unique(np.linspace(0, len(log) - 1, min(len(log), 20)).astype(int))
-            keep["moves"] = [[int(log[i, 0]), float(log[i, 3]), float(log[i, 4])] for i in pick]
+        if len(log):  # [steps, largest move, largest shape move], thinned to ~10 rows
+            pick = np.unique(np.linspace(0, len(log) - 1, min(len(log), 10)).astype(int))
+            keep["moves"] = [[int(log[i, 0]), float(f"{log[i, 3]:.3g}"), float(f"{log[i, 4]:.3g}")]
+                             for i in pick]
         row["folds"].append(keep)
     return row
 
@@ -688,7 +687,7 @@ def main() -> None:
         start = time.perf_counter()
         rows = run_library(root, jobs, commit, cfg, states, tmp)
     record.meta["wall_seconds"] = time.perf_counter() - start
-    record.write({"files": rows, "totals": totals(rows, cfg["percents"])})
+    record.write({"files": rows, "totals": totals(rows, cfg["percents"])}, indent=None)
     print(table({"meta": record.meta, "files": rows}))
 
 
@@ -721,8 +720,12 @@ def table(out: dict) -> str:
         fmt = (lambda x: "–" if x is None else f"{x:.2f}")
         rows.append([f"{percent} %", f"{v['folds']}", f"{v['reached_a']}", fmt(v["median_a_seconds"]),
                      f"{v['settled']}", fmt(v["median_b_seconds_settled"])])
+    busy = [r["others_busy"] for r in out["files"] if "others_busy" in r]
     head = (f"{t['read']} of {t['files']} files read"
-            + (f" (failed: {', '.join(t['failed'])})" if t["failed"] else ""))
+            + (f" (failed: {', '.join(t['failed'])})" if t["failed"] else "")
+            + f"; stepping capped at {out['meta']['harness']['limit_s']:g} s per fold"
+            + (f"; other jobs used a median {statistics.median(busy):.0%} of the cores"
+               if busy else ""))
     return head + "\n\n" + _meta.markdown_table(
         ["fold", "folds run", "(a) reached", "(a) median s", "(b) settled",
          "(b) median s (settled)"], rows)
