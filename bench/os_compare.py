@@ -48,6 +48,7 @@ import os_library as osl
 MATCH = 1e-2   # vertices of the two readers this close (unit bounding radius) are one
 RUNS = 3
 CLI_PERCENT = 90
+CLI_LIMIT_S = 120.0  # a whole CLI run stopped past this is recorded as None
 
 
 def pattern_of_mesh(state: dict):
@@ -150,13 +151,17 @@ def one_file(path: Path, svgs: Path, runs: int) -> dict:
     return row
 
 
-def cli_seconds(svg: Path) -> float:
-    """Wall seconds of the whole ``foldcore simulate SVG --fold-percent 90 -q`` process."""
+def cli_seconds(svg: Path) -> float | None:
+    """Wall seconds of the whole ``foldcore simulate SVG --fold-percent 90 -q`` process;
+    None past :data:`CLI_LIMIT_S`."""
     with tempfile.TemporaryDirectory() as tmp:
         t0 = time.perf_counter()
-        subprocess.run([sys.executable, "-m", "foldcore", "simulate", str(svg),
-                        "--fold-percent", str(CLI_PERCENT), "-q"], cwd=tmp,
-                       capture_output=True, check=False)
+        try:
+            subprocess.run([sys.executable, "-m", "foldcore", "simulate", str(svg),
+                            "--fold-percent", str(CLI_PERCENT), "-q"], cwd=tmp,
+                           capture_output=True, check=False, timeout=CLI_LIMIT_S)
+        except subprocess.TimeoutExpired:
+            return None
         return time.perf_counter() - t0
 
 
@@ -210,8 +215,9 @@ def totals(rows: list[dict]) -> dict:
                      "over_10s": int(sum(f[kind]["seconds"] > 10.0 for f in done)),
                      "largest_s": float(max(f[kind]["seconds"] for f in done))}
     cli = [(r["cli_s"], r["os_load_s"] + f["os_still_s"]) for r in rows
-           for f in r["folds"] if "cli_s" in r and f["percent"] == CLI_PERCENT
+           for f in r["folds"] if r.get("cli_s") is not None and f["percent"] == CLI_PERCENT
            and r.get("os_load_s") is not None]
+    out["cli_over_limit"] = sum("cli_s" in r and r["cli_s"] is None for r in rows)
     if cli:
         out["cli"] = {"files": len(cli), "median_s": _meta.median([c for c, _ in cli]),
                       "median_os_s": _meta.median([o for _, o in cli]),
@@ -243,7 +249,8 @@ def table(data: dict) -> str:
         lines += ["", f"Whole `foldcore simulate FILE.svg --fold-percent {CLI_PERCENT}` "
                   f"process: median {_meta.sig(c['median_s'])} s over {c['files']} files "
                   f"against Origami Simulator's read + fold {_meta.sig(c['median_os_s'])} s; "
-                  f"faster on {c['faster_than_os']} of {c['files']}."]
+                  f"faster on {c['faster_than_os']} of {c['files']}; "
+                  f"{t['cli_over_limit']} files past {CLI_LIMIT_S:g} s."]
     return "\n".join(lines)
 
 

@@ -27,7 +27,7 @@ from elements.cache import choose_cache_dir
 
 choose_cache_dir(Path(__file__))  # before this module's cache=True kernels (read-only installs)
 
-STEP = 1e-8  # forward-difference step of the Hessians, normalised units (√ε: ~1e-8 relative)
+STEP = 1e-8  # forward-difference step of the Hessians × the element's size (√ε: ~1e-8 relative)
 
 
 @njit(cache=True, inline="always")
@@ -139,6 +139,27 @@ def _triangle_gradient(p, k, rest, g):
 
 
 @njit(cache=True)
+def _element_size(p, size):
+    """The element's smallest height (or a bar's length): the scale its forces change
+    over, so the difference step of its Hessian is a fixed share of it (a sliver
+    triangle 1e-6 high needs steps well below 1e-6)."""
+    if size == 2:
+        d = _vec(p, 1, 0)
+        return max(math.sqrt(_dot(d, d)), 1e-300)
+    smallest = math.inf
+    for i in range(size):  # each side of each triangle, the height over it
+        for j in range(i + 1, size):
+            e = _vec(p, j, i)
+            le = math.sqrt(_dot(e, e))
+            smallest = min(smallest, le)
+            for k in range(size):
+                if k != i and k != j and (size == 3 or (i, j) == (0, 1)):
+                    n = _cross(e, _vec(p, k, i))
+                    smallest = min(smallest, math.sqrt(_dot(n, n)) / max(le, 1e-300))
+    return max(smallest, 1e-300)
+
+
+@njit(cache=True)
 def _element_gradient(kind, p, k, rest, reference, g):
     """Energy and gradient (into g) of one element of ``kind`` 0 bar, 1 hinge,
     2 triangle at its points ``p``."""
@@ -179,16 +200,17 @@ def evaluate(x, nodes, sizes, kinds, stiffness, rest, reference, energy, gradien
         if not want_hessian:
             continue
         gp = np.zeros((size, 3))
+        step = STEP * _element_size(p, size)
         for a in range(size):
             for c in range(3):
                 keep = p[a, c]
-                p[a, c] = keep + STEP
+                p[a, c] = keep + step
                 _element_gradient(kinds[e], p, stiffness[e], rest[e], reference[e], gp)
                 p[a, c] = keep
                 column = 3 * a + c
                 for b in range(size):
                     for d in range(3):
-                        hessian[e, 3 * b + d, column] = (gp[b, d] - g[b, d]) / STEP
+                        hessian[e, 3 * b + d, column] = (gp[b, d] - g[b, d]) / step
         for i in range(3 * size):  # symmetric: the mean of the two differences
             for j in range(i):
                 mean = 0.5 * (hessian[e, i, j] + hessian[e, j, i])
