@@ -106,3 +106,13 @@ def test_origami_simulator_svg_folds_without_a_thickness(tmp_path):
     assert fold.converged
     report = json.loads((tmp_path / "w.json").read_text())
     assert report["sheet"]["triangles"] == len(foldcore.io.read(REAL + "waterbombBase.svg").faces)
+
+
+def test_the_newton_budget_is_the_sheets_own_unless_given(miura_file, tmp_path):
+    report = tmp_path / "r.json"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RunWarning)
+        foldcore.simulate(miura_file, outputs={"report": report})
+        assert json.loads(report.read_text())["settings"]["max_iterations"] == 500
+        short = foldcore.simulate(miura_file, solving={"max_iterations": 2})
+    assert short.iterations == 2 and short.reason == "budget" and not short.converged

@@ -63,12 +63,22 @@ def run_thin(job, loaded, on_start=None, callback=None):
     if on_start is not None:
         on_start()
     try:
-        result, interrupted = solver.run(s.tolerance, s.max_iterations,
+        result, interrupted = solver.run(s.tolerance, newton_budget(s),
                                          _callback(callback)), False
     except KeyboardInterrupt:
         result, interrupted = solver.result("interrupted"), True
     result.timings_s.update(setup=setup, total=setup + result.timings_s["solve"])
     return sheet, solver, result, interrupted
+
+
+def newton_budget(solving) -> int:
+    """The run's Newton steps: ``solving.max_iterations`` when set, else the sheet's own
+    :data:`foldcore.sheet.solve.MAX_ITERATIONS` (the default budget is sized for the
+    thick strategies' thousands of cheap steps, not for Newton's tens)."""
+    from .sheet.solve import MAX_ITERATIONS
+
+    default = next(f.default for f in fields(Solving) if f.name == "max_iterations")
+    return MAX_ITERATIONS if solving.max_iterations == default else solving.max_iterations
 
 
 def thin_summary(job, pattern, result) -> str:
@@ -109,5 +119,5 @@ def thin_settings(job) -> dict:
     """What the report records of a thin-sheet run's settings."""
     s = job.solving
     return {"pattern": job.source, "model": "sheet", "fold_percent": s.fold_percent,
-            "tolerance": s.tolerance, "max_iterations": s.max_iterations,
+            "tolerance": s.tolerance, "max_iterations": newton_budget(s),
             "thickness_mm": None}
