@@ -137,7 +137,26 @@ def planarise(segments: np.ndarray, tol: float, source: str = "<segments>"):
     keep = edges[:, 0] != edges[:, 1]  # a piece shorter than tol: its ends merged
     edges, first = np.unique(edges[keep], axis=0, return_index=True)
     used, edges = np.unique(edges, return_inverse=True)
-    return vertices[used], edges.reshape(-1, 2), pieces[keep][first]
+    vertices, edges = in_drawing_order(vertices[used], edges.reshape(-1, 2), segments, tol)
+    return vertices, edges, pieces[keep][first]
+
+
+def in_drawing_order(vertices: np.ndarray, edges: np.ndarray, segments: np.ndarray,
+                     tol: float):
+    """(vertices, edges) renumbered in the order the drawing first reaches each vertex
+    (the segments' endpoints in file order; crossings after them, as they were), as
+    Origami Simulator numbers them: the diagonal a thin sheet cuts a square along
+    follows the numbering (:func:`foldcore.sheet.build.face_triangles`)."""
+    from scipy.spatial import cKDTree
+
+    distance, nearest = cKDTree(vertices).query(segments.reshape(-1, 2))
+    first = np.full(len(vertices), len(nearest), dtype=np.int64)
+    reached = distance <= tol
+    np.minimum.at(first, nearest[reached], np.flatnonzero(reached))
+    order = np.lexsort((np.arange(len(vertices)), first))
+    new_id = np.empty(len(vertices), dtype=np.int64)
+    new_id[order] = np.arange(len(vertices))
+    return vertices[order], new_id[edges]
 
 
 def _merge_close(points: np.ndarray, tol: float, source: str):
