@@ -178,10 +178,10 @@ def _add_reading(sim) -> None:
 
 
 def _add_thickening(sim) -> None:
-    extent = "× the sheet's extent"
+    extent, lo, hi = "× the sheet's extent", *THICKNESS_RATIO
     sim.add_argument("--thickness", type=_positive,
-                     help="sheet thickness H in mm (default: the file's foldcore:thickness), "
-                          f"{THICKNESS_RATIO[0]:g} … {THICKNESS_RATIO[1]:g} {extent}")
+                     help="sheet thickness H in mm (default: the file's foldcore:thickness; "
+                          f"none: a thin sheet), {lo:g} … {hi:g} {extent}")
     sim.add_argument("--hinge-width", type=_positive,
                      help="hinge width W in mm for every crease (default: the file's widths, "
                           f"else Eq. 7 with r = 0), {WIDTH_RATIO[0]:g} … {WIDTH_RATIO[1]:g} "

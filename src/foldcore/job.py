@@ -8,7 +8,8 @@ Reads the pattern (:mod:`foldcore.io`, Origami Simulator's conventions:
 :mod:`foldcore.io.conventions`), checks every output path before any work
 (:mod:`foldcore.destinations`), thickens, runs the simulation at the fold
 percent (or along an animation's sweep) and writes the outputs (the data files
-all or nothing, then the picture)
+all or nothing, then the picture); a pattern with no thickness folds as a thin
+sheet instead (:mod:`foldcore.sheet_job`)
 (:mod:`foldcore.outputs`). Warnings the run calls for — nothing driven, or
 converged with its targets missed — are :class:`foldcore.errors.RunWarning`.
 Every option is in one of four groups (:mod:`foldcore.options`), with the
@@ -74,7 +75,8 @@ def simulate(path, *, hinges=None, reading=None, thickening=None, solving=None,
 
     Returns
     -------
-    Result
+    Result, or :class:`foldcore.sheet.SheetFold` when the pattern has no thickness
+    (folded as a thin sheet, Origami Simulator's model: :mod:`foldcore.sheet_job`)
 
     Raises
     ------
