@@ -129,6 +129,20 @@ def _corner_angles(p: np.ndarray) -> np.ndarray:
     return out
 
 
+def _collapsed_hinges(flat: np.ndarray, hinges: np.ndarray) -> np.ndarray:
+    """(H,) bool: a hinge one of whose triangles is lower over it than
+    :data:`~.kernels.COLLAPSED` in the flat sheet (a face cut along collinear points)."""
+    from .kernels import COLLAPSED
+
+    e = flat[hinges[:, 1], :2] - flat[hinges[:, 0], :2]
+    length = np.maximum(np.linalg.norm(e, axis=1), 1e-300)
+    low = np.zeros(len(hinges), dtype=bool)
+    for tip in (2, 3):
+        r = flat[hinges[:, tip], :2] - flat[hinges[:, 0], :2]
+        low |= np.abs(e[:, 0] * r[:, 1] - e[:, 1] * r[:, 0]) / length < COLLAPSED
+    return low
+
+
 def build_sheet(pattern: CreasePattern, stiffness: Stiffness = Stiffness()) -> Sheet:
     """The bar-and-hinge :class:`Sheet` of ``pattern`` (module docstring)."""
     xy = np.asarray(pattern.vertices, dtype=float)
@@ -147,7 +161,10 @@ def build_sheet(pattern: CreasePattern, stiffness: Stiffness = Stiffness()) -> S
     kinds = np.asarray(pattern.assignments)
     targets = np.zeros(len(hinges))
     spring = np.zeros(len(hinges))  # per-length stiffness, 0: no spring
+    collapsed = _collapsed_hinges(flat, hinges)
     for h, e in enumerate(hinge_edge):
+        if collapsed[h]:
+            continue  # no angle to spring: Origami Simulator disables it too
         if e < 0:
             spring[h] = stiffness.facet
         elif kinds[e] in ("M", "V", "F") and not np.isnan(angles[e]):

@@ -28,6 +28,9 @@ from elements.cache import choose_cache_dir
 choose_cache_dir(Path(__file__))  # before this module's cache=True kernels (read-only installs)
 
 STEP = 1e-8  # forward-difference step of the Hessians × the element's size (√ε: ~1e-8 relative)
+#: A triangle lower than this (normalised units) has collapsed: Origami Simulator's
+#: tolerance, below which it disables a crease; the smallest element size a step scales to.
+COLLAPSED = 1e-6
 
 
 @njit(cache=True, inline="always")
@@ -156,7 +159,7 @@ def _element_size(p, size):
                 if k != i and k != j and (size == 3 or (i, j) == (0, 1)):
                     n = _cross(e, _vec(p, k, i))
                     smallest = min(smallest, math.sqrt(_dot(n, n)) / max(le, 1e-300))
-    return max(smallest, 1e-300)
+    return max(smallest, COLLAPSED)
 
 
 @njit(cache=True)
