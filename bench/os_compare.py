@@ -23,7 +23,9 @@ degrees, both sheets measured by Origami Simulator's own signed dihedral angle
 file the whole ``foldcore simulate FILE.svg --fold-percent 90 -q`` process
 (start-up included) against Origami Simulator's read time plus its (b) at 90 %.
 Origami Simulator's times come from the run that recorded the states, so the
-ratios are of two runs on the same machine, not interleaved.
+ratios are of two runs on the same machine, not interleaved. Folds where
+Origami Simulator did not settle have no shape to compare with: foldcore's
+fold of the file (its reader, one run) is timed alone.
 
 Writes bench/results/os_compare.json and .png (foldcore's time against Origami
 Simulator's, and the shape differences). Run: ``python bench/os_compare.py``
@@ -130,6 +132,11 @@ def one_file(path: Path, svgs: Path, runs: int) -> dict:
     row["matched"] = nodes is not None
     for entry in state["folds"]:
         if entry.get("positions_b") is None or not entry["settled"]:
+            if user_pattern is not None:  # no shape to compare with: foldcore's time alone
+                result, seconds = fold(user_pattern, entry["percent"], 1)
+                row["folds"].append({"percent": entry["percent"], "unsettled_os": {
+                    "reason": result.reason, "iterations": result.iterations,
+                    "seconds": seconds}})
             continue
         out = {"percent": entry["percent"], "os_still_s": entry["b_seconds"],
                "os_strain_s": entry["a_seconds"]}
@@ -194,7 +201,8 @@ def tied_quadrilaterals(state: dict) -> tuple[int, int]:
 def totals(rows: list[dict]) -> dict:
     """The library in numbers: files read, matched, compared; shape differences and
     time ratios over every settled fold (medians, largest, counts)."""
-    folds = [f for r in rows for f in r["folds"]]
+    folds = [f for r in rows for f in r["folds"] if "unsettled_os" not in f]
+    alone = [f["unsettled_os"] for r in rows for f in r["folds"] if "unsettled_os" in f]
     out = {"files": len(rows), "os_read": sum("os_error" not in r for r in rows),
            "foldcore_read": sum("read_error" not in r and "os_error" not in r for r in rows),
            "matched": sum(r.get("matched", False) for r in rows),
@@ -216,7 +224,13 @@ def totals(rows: list[dict]) -> dict:
                      "largest_s": float(max(f[kind]["seconds"] for f in done))}
     cli = [(r["cli_s"], r["os_load_s"] + f["os_still_s"]) for r in rows
            for f in r["folds"] if r.get("cli_s") is not None and f["percent"] == CLI_PERCENT
-           and r.get("os_load_s") is not None]
+           and r.get("os_load_s") is not None and "os_still_s" in f]
+    if alone:
+        out["unsettled_os"] = {"folds": len(alone),
+                               "converged": sum(a["reason"] == "converged" for a in alone),
+                               "median_s": _meta.median([a["seconds"] for a in alone]),
+                               "over_10s": sum(a["seconds"] > 10.0 for a in alone),
+                               "largest_s": max(a["seconds"] for a in alone)}
     out["cli_over_limit"] = sum("cli_s" in r and r["cli_s"] is None for r in rows)
     if cli:
         out["cli"] = {"files": len(cli), "median_s": _meta.median([c for c, _ in cli]),
@@ -244,6 +258,12 @@ def table(data: dict) -> str:
                          k["within_1deg"], k["converged"], f"{_meta.sig(k['median_speedup'])}×",
                          k["slower_than_os"], f"{k['over_10s']} ({_meta.sig(k['largest_s'])} s)"])
     lines.append(_meta.markdown_table(header, body))
+    if "unsettled_os" in t:
+        u = t["unsettled_os"]
+        lines += ["", f"Folds where Origami Simulator did not settle within its limit "
+                  f"(foldcore's reader, timed alone): {u['folds']}, {u['converged']} "
+                  f"converged; median {_meta.sig(u['median_s'])} s, "
+                  f"{u['over_10s']} over 10 s (largest {_meta.sig(u['largest_s'])} s)."]
     if "cli" in t:
         c = t["cli"]
         lines += ["", f"Whole `foldcore simulate FILE.svg --fold-percent {CLI_PERCENT}` "

@@ -3,8 +3,9 @@
 Origami Simulator reaches its shape by damped dynamics, thousands of explicit
 steps; the shape it settles to is a minimum of the sheet's energy, which
 Newton's method reaches in tens of steps. Each step solves
-``(H + μ I) Δx = −g`` (H the sparse Hessian, a CHOLMOD factor reused
-symbolically from step to step), with a backtracking line search on the
+``(H + μ D) Δx = −g`` (H the sparse Hessian, a CHOLMOD factor reused
+symbolically from step to step; D its diagonal's magnitudes plus their
+median, Marquardt's scaling), with a backtracking line search on the
 energy. μ (Levenberg–Marquardt) keeps the matrix positive definite away from
 the minimum (the Hessian of a hinge far from its target is indefinite) and
 fixes the six rigid motions, which the energy does not see; it shrinks as
