@@ -166,12 +166,12 @@ def _fold_thin(job, loaded, on_start, callback) -> Fold:
 
     check_thin(job)
     sheet, solver, result, interrupted = run_thin(job, loaded, on_start, callback)
-    summary = thin_summary(job, loaded.pattern, result)
+    summary, settings = thin_summary(job, loaded.pattern, result), thin_settings(job)
     with interrupts_deferred() as late:
-        write_thin(job, loaded.pattern, sheet, result, interrupted)
+        write_thin(job, loaded.pattern, sheet, result, settings, interrupted)
     if interrupted or late:
         raise Interrupted(result, _written(job.outputs), partial=interrupted)
-    return Fold(loaded.pattern, sheet, solver, result, thin_settings(job), summary)
+    return Fold(loaded.pattern, sheet, solver, result, settings, summary)
 
 
 def _written(out) -> dict:

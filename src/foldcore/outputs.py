@@ -54,8 +54,8 @@ def series_frame(mesh, result, percent: float) -> dict:
     frame = folded_frame(mesh, result.positions)
     targets = result.target_angles_deg
     frame.update({"frame_title": f"fold percent {percent:g}", SERIES_PERCENT_KEY: percent,
-                  SERIES_ANGLE_KEY: _nullable(in_fold_range(result.fold_angles_deg)),
-                  SERIES_TARGET_KEY: None if targets is None else _nullable(targets),
+                  SERIES_ANGLE_KEY: nullable(in_fold_range(result.fold_angles_deg)),
+                  SERIES_TARGET_KEY: None if targets is None else nullable(targets),
                   "foldcore:converged": bool(result.converged),
                   "foldcore:reason": result.reason,
                   "foldcore:iterations": int(result.iterations)})
@@ -68,7 +68,8 @@ def in_fold_range(angles) -> np.ndarray:
     return np.clip(angles, -180.0, 180.0)
 
 
-def _nullable(values) -> list:
+def nullable(values) -> list:
+    """Floats as a JSON list, None where not finite."""
     return [float(v) if np.isfinite(v) else None for v in np.asarray(values, dtype=float)]
 
 
@@ -201,9 +202,9 @@ def hinge_entries(result, pattern, mesh) -> dict:
     pivoting = np.flatnonzero(np.nan_to_num(angles - pivot, nan=-1.0) > 0)
     overlap = crease_overlaps(pattern, mesh, result.positions)
     out = {"model": [str(m) if m else None for m in models],
-           "pivot_angle_deg": _nullable(pivot), "pivoting_edges": pivoting.tolist(),
+           "pivot_angle_deg": nullable(pivot), "pivoting_edges": pivoting.tolist(),
            "largest_overlap_mm": float(np.nanmax(overlap, initial=0.0)),
-           "overlap_mm": _nullable(overlap)}
+           "overlap_mm": nullable(overlap)}
     misfit = result.hinge_misfit_mm
     if misfit is not None and len(misfit):
         worst = int(np.argmax(misfit))
@@ -228,8 +229,8 @@ def report_dict(result, pattern, mesh, settings: dict, quantities: dict | None =
         "residual": float(result.residual) if np.isfinite(result.residual) else None,
         "energy": float(energy[-1]) if len(energy) else 0.0,
         "energy_history": energy.tolist(),
-        "fold_angles_deg": _nullable(result.fold_angles_deg),
-        "target_angles_deg": _nullable(result.target_angles_deg
+        "fold_angles_deg": nullable(result.fold_angles_deg),
+        "target_angles_deg": nullable(result.target_angles_deg
                                        if result.target_angles_deg is not None
                                        else pattern.fold_angles),
         "actuation": actuation_entries(result, pattern),
@@ -241,7 +242,7 @@ def report_dict(result, pattern, mesh, settings: dict, quantities: dict | None =
         **_strain_entries(result),
         "vertices": int(mesh.n_vertices),
         "elements": {name: len(g) for name, g in mesh.groups.items()},
-        "hinge_width_mm": _nullable(mesh.hinge_width),
+        "hinge_width_mm": nullable(mesh.hinge_width),
         "subdivisions": mesh.subdivisions.tolist(),
         "timings_s": {k: float(v) for k, v in result.timings_s.items()},
         **_iteration_cost(result),

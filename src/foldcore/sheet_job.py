@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import time
 import warnings
-from dataclasses import fields
 
 from .errors import RunWarning
 from .options import OptionError, Outputs, Solving, Thickening
@@ -32,10 +31,9 @@ THICK_ONLY = (("thickening", Thickening, ("hinge_width", "subdivisions", "hinge"
 def thick_options_set(job) -> list[str]:
     """``group.field`` of every option of a thick sheet only that ``job`` sets."""
     out = []
-    for group, cls, names in THICK_ONLY:
-        defaults = {f.name: f.default for f in fields(cls)}
+    for group, cls, names in THICK_ONLY:  # a dataclass's attribute is its field's default
         values = getattr(job, group)
-        out += [f"{group}.{n}" for n in names if getattr(values, n) != defaults[n]]
+        out += [f"{group}.{n}" for n in names if getattr(values, n) != getattr(cls, n)]
     return out
 
 
@@ -77,8 +75,8 @@ def newton_budget(solving) -> int:
     thick strategies' thousands of cheap steps, not for Newton's tens)."""
     from .sheet.solve import MAX_ITERATIONS
 
-    default = next(f.default for f in fields(Solving) if f.name == "max_iterations")
-    return MAX_ITERATIONS if solving.max_iterations == default else solving.max_iterations
+    given = solving.max_iterations != Solving.max_iterations  # the dataclass's default
+    return solving.max_iterations if given else MAX_ITERATIONS
 
 
 def thin_summary(job, pattern, result) -> str:
@@ -92,12 +90,13 @@ def thin_summary(job, pattern, result) -> str:
     return summary
 
 
-def write_thin(job, pattern, sheet, result, partial: bool) -> None:
-    """The outputs ``job`` asks for (:func:`foldcore.sheet_outputs.write_sheet_result`)."""
+def write_thin(job, pattern, sheet, result, settings: dict, partial: bool) -> None:
+    """The outputs ``job`` asks for (:func:`foldcore.sheet_outputs.write_sheet_result`),
+    ``settings`` (:func:`thin_settings`) recorded in the report."""
     from .sheet_outputs import write_sheet_result
 
     out = job.outputs
-    write_sheet_result(result, pattern, sheet, thin_settings(job), fold_path=out.fold,
+    write_sheet_result(result, pattern, sheet, settings, fold_path=out.fold,
                        report=out.report, png=out.render, partial=partial)
 
 

@@ -15,7 +15,7 @@ import numpy as np
 
 from .io.fold_json import MODEL_KEY
 from .outputs import (FACE_PART_KEY, PARTIAL_KEY, actuation_entries, in_fold_range,
-                      machine_entries, write_picture, write_report)
+                      machine_entries, nullable, write_picture, write_report)
 
 MODEL = "sheet"
 
@@ -43,8 +43,8 @@ def sheet_report(fold, pattern, sheet, settings: dict) -> dict:
         "residual": float(fold.residual),
         "residual_unit": "largest force imbalance at a node / the forces meeting there",
         "energy": float(fold.energy),
-        "fold_angles_deg": _nullable(fold.fold_angles_deg),
-        "target_angles_deg": _nullable(fold.target_angles_deg),
+        "fold_angles_deg": nullable(fold.fold_angles_deg),
+        "target_angles_deg": nullable(fold.target_angles_deg),
         "actuation": actuation_entries(fold, pattern),
         "sheet": {"vertices": int(len(sheet.flat)), "triangles": int(len(sheet.triangles)),
                   "creases": int(np.count_nonzero(sprung & (sheet.hinge_edge >= 0))),
@@ -56,10 +56,6 @@ def sheet_report(fold, pattern, sheet, settings: dict) -> dict:
         "settings": settings,
         "machine": machine_entries(),
     }
-
-
-def _nullable(values) -> list:
-    return [float(v) if np.isfinite(v) else None for v in np.asarray(values, dtype=float)]
 
 
 def write_sheet_result(fold, pattern, sheet, settings: dict, *, fold_path=None, report=None,

@@ -70,14 +70,12 @@ def sides_read_as_origami_simulator(vertices, edges, assignments, fold_angles, s
     F, U) with the sheet on one side only is boundary (B: no face to fold against),
     a boundary line (B) with the sheet on both sides is a free hinge (U: a bar
     without a spring)."""
-    from ..planar import derive_face_loops
+    from ..planar import derive_face_loops, loop_starts, next_in_loop
 
     assignments = np.array(assignments, dtype="<U1")
     fold_angles = np.array(fold_angles, dtype=float)
     flat, lengths = derive_face_loops(vertices, edges, assignments == "B", source)
-    following = np.arange(len(flat)) + 1
-    starts = np.concatenate([[0], np.cumsum(lengths)[:-1]])
-    following[starts + lengths - 1] = starts
+    following = next_in_loop(loop_starts(lengths), lengths)
     n = len(vertices)
     edge_keys = np.minimum(edges[:, 0], edges[:, 1]) * n + np.maximum(edges[:, 0], edges[:, 1])
     side_keys = np.minimum(flat, flat[following]) * n + np.maximum(flat, flat[following])

@@ -55,7 +55,6 @@ class Sheet:
     triangle_face : (T,) int, the pattern face each triangle cuts
     hinges : (H, 4) int, (a, b, c, d): the hinge a → b, c left, d right
     hinge_edge : (H,) int, the pattern edge of each hinge, −1 for a diagonal
-    targets : (H,) float, radians at 100 %, valley > 0 (0 for facets and passive)
     nodes, sizes, kinds, stiffness, rest : the element arrays of
         :func:`foldcore.sheet.kernels.evaluate`; hinges are the elements
         ``hinge_elements``
@@ -70,7 +69,6 @@ class Sheet:
     triangle_face: np.ndarray
     hinges: np.ndarray
     hinge_edge: np.ndarray
-    targets: np.ndarray
     nodes: np.ndarray
     sizes: np.ndarray
     kinds: np.ndarray
@@ -129,18 +127,21 @@ def _corner_angles(p: np.ndarray) -> np.ndarray:
     return out
 
 
+def tip_heights(flat: np.ndarray, hinges: np.ndarray) -> np.ndarray:
+    """(H, 2) heights of each hinge's tips c and d over its line a → b in the flat
+    sheet ``flat`` (N, 3), normalised units."""
+    e = flat[hinges[:, 1], :2] - flat[hinges[:, 0], :2]
+    length = np.maximum(np.linalg.norm(e, axis=1), 1e-300)
+    r = flat[hinges[:, 2:], :2] - flat[hinges[:, :1], :2]          # (H, 2, 2)
+    return np.abs(e[:, None, 0] * r[..., 1] - e[:, None, 1] * r[..., 0]) / length[:, None]
+
+
 def _collapsed_hinges(flat: np.ndarray, hinges: np.ndarray) -> np.ndarray:
     """(H,) bool: a hinge one of whose triangles is lower over it than
     :data:`~.kernels.COLLAPSED` in the flat sheet (a face cut along collinear points)."""
     from .kernels import COLLAPSED
 
-    e = flat[hinges[:, 1], :2] - flat[hinges[:, 0], :2]
-    length = np.maximum(np.linalg.norm(e, axis=1), 1e-300)
-    low = np.zeros(len(hinges), dtype=bool)
-    for tip in (2, 3):
-        r = flat[hinges[:, tip], :2] - flat[hinges[:, 0], :2]
-        low |= np.abs(e[:, 0] * r[:, 1] - e[:, 1] * r[:, 0]) / length < COLLAPSED
-    return low
+    return tip_heights(flat, hinges).min(axis=1) < COLLAPSED
 
 
 def build_sheet(pattern: CreasePattern, stiffness: Stiffness = Stiffness()) -> Sheet:
@@ -197,5 +198,5 @@ def _assemble(flat, centre, radius, cut, hinges, hinge_edge, targets, spring, ba
     rest[nb + nh:] = _corner_angles(flat[triangles][:, :, :2])
     hinge_elements = np.full(len(hinges), -1, dtype=np.int64)
     hinge_elements[sprung] = nb + np.arange(nh)
-    return Sheet(flat, centre, radius, triangles, triangle_face, hinges, hinge_edge, targets,
-                 nodes, sizes, kinds, k, rest, hinge_elements, stiffness)
+    return Sheet(flat, centre, radius, triangles, triangle_face, hinges, hinge_edge, nodes,
+                 sizes, kinds, k, rest, hinge_elements, stiffness)

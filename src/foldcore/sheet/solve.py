@@ -21,7 +21,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..linsolve import Factor, not_positive_definite
-from .build import HINGE, Sheet
+from .build import HINGE, Sheet, tip_heights
 from .kernels import evaluate, fold_angles
 
 TOLERANCE = 1e-8       # largest relative force imbalance at equilibrium (SheetSolver.residual)
@@ -258,15 +258,8 @@ def unit_force(sheet: Sheet) -> float:
     hinges = sheet.nodes[sheet.kinds == HINGE]
     if not len(hinges):
         return 1.0
-    p = sheet.flat[:, :2]
-    e = p[hinges[:, 1]] - p[hinges[:, 0]]
-    length = np.linalg.norm(e, axis=1)
-    heights = []
-    for tip in (2, 3):
-        r = p[hinges[:, tip]] - p[hinges[:, 0]]
-        heights.append(np.abs(e[:, 0] * r[:, 1] - e[:, 1] * r[:, 0]) / length)
     k = sheet.stiffness[sheet.kinds == HINGE]
-    return float(np.median(k / np.minimum(*heights)))
+    return float(np.median(k / tip_heights(sheet.flat, hinges).min(axis=1)))
 
 
 def _normalised(sheet: Sheet, positions_mm: np.ndarray) -> np.ndarray:
