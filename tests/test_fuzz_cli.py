@@ -80,21 +80,28 @@ def check(argv: list[str], folder, outputs: list[str]) -> None:
         assert name in outputs, (name, argv)
 
 
-@pytest.fixture(scope="module")
-def crease(tmp_path_factory):
-    """A valid pattern that folds in a few steps: one crease, H = 1 mm in the file."""
-    path = tmp_path_factory.mktemp("cli") / "crease.fold"
+def crease_bytes(folder, thickness: float | None) -> bytes:
+    """One crease that folds in a few steps, as a FOLD file (thickness in the file,
+    mm, or none: a thin sheet)."""
+    path = folder / "crease.fold"
     write_fold(path, patterns.single_hinge(panel_length=10.0, depth=5.0, angle=60.0,
-                                           width=2.0), thickness=1.0)
+                                           width=2.0), thickness=thickness)
     return path.read_bytes()
 
 
+@pytest.fixture(scope="module")
+def crease(tmp_path_factory):
+    """The crease with H = 1 mm in the file, and without a thickness (a thin sheet)."""
+    return (crease_bytes(tmp_path_factory.mktemp("cli"), 1.0),
+            crease_bytes(tmp_path_factory.mktemp("cli"), None))
+
+
 @st.composite
-def simulate_commands(draw, crease: bytes) -> tuple[str, bytes, list[str], str]:
+def simulate_commands(draw, crease: tuple[bytes, bytes]) -> tuple[str, bytes, list[str], str]:
     """(input name, its bytes, options, output name)."""
-    kind = draw(st.sampled_from(["crease", "crease", "fold", "svg"]))
-    if kind == "crease":
-        name, blob = "in.fold", crease
+    kind = draw(st.sampled_from(["crease", "thin", "fold", "svg"]))
+    if kind in ("crease", "thin"):
+        name, blob = "in.fold", crease[kind == "thin"]
     elif kind == "fold":
         name, blob = "in.fold", _json_bytes(draw(corrupted_folds())) or b"{}"
     else:
@@ -119,14 +126,17 @@ def test_fuzz_simulate(crease, tmp_path_factory, data):
 
 @pytest.fixture(scope="module")
 def results(crease, tmp_path_factory):
-    """A result file of the crease, as written by ``simulate -o``."""
+    """Result files of the crease, thick and thin, as written by ``simulate -o``."""
     import json
 
     folder = tmp_path_factory.mktemp("res")
-    (folder / "crease.fold").write_bytes(crease)
-    out = folder / "crease.result.fold"
-    assert main(["simulate", str(folder / "crease.fold"), "-o", str(out)]) == 0
-    return [json.loads(out.read_text())]
+    files = []
+    for name, blob in zip(("thick", "thin"), crease):
+        (folder / f"{name}.fold").write_bytes(blob)
+        out = folder / f"{name}.result.fold"
+        assert main(["simulate", str(folder / f"{name}.fold"), "-o", str(out)]) == 0
+        files.append(json.loads(out.read_text()))
+    return files
 
 
 @pytest.mark.parametrize("command", ["view", "export", "render"])
