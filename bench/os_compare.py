@@ -77,24 +77,30 @@ def normalised(xy: np.ndarray) -> np.ndarray:
 
 
 def match(pattern, state: dict):
-    """(Origami Simulator's node of each pattern vertex, largest gap) or (None, gap)."""
+    """(Origami Simulator's node of each node of foldcore's sheet, largest gap) or
+    (None, gap): the sheet leaves out straight degree-2 vertices as Origami
+    Simulator does, so its nodes, not the pattern's vertices, are matched."""
     from scipy.spatial import cKDTree
+    from foldcore.sheet import build_sheet
 
     theirs = normalised(state["fold"]["vertices_coords"][:, [0, 2]] * [1.0, -1.0])
-    gap, idx = cKDTree(theirs).query(normalised(np.asarray(pattern.vertices, dtype=float)))
+    vertices = np.asarray(pattern.vertices, dtype=float)
+    mine = normalised(vertices)[build_sheet(pattern, merge_straight=True).vertex_ids]
+    gap, idx = cKDTree(theirs).query(mine)
     gap = float(gap.max())
     one_to_one = len(idx) == len(theirs) and len(np.unique(idx)) == len(idx)
     return (idx if gap <= MATCH and one_to_one else None), gap
 
 
-def fold(pattern, percent: float, runs: int):
-    """(SheetFold, median seconds) of ``runs`` folds of ``pattern`` from flat."""
+def fold(pattern, percent: float, runs: int, drawing: bool = False):
+    """(SheetFold, median seconds) of ``runs`` folds of ``pattern`` from flat
+    (``drawing``: read from an SVG, built as ``simulate`` builds it)."""
     from foldcore.sheet import SheetSolver, build_sheet
 
     seconds, result = [], None
     for _ in range(runs):
         t0 = time.perf_counter()
-        result = SheetSolver(build_sheet(pattern), percent,
+        result = SheetSolver(build_sheet(pattern, merge_straight=drawing), percent,
                              pattern_edges=pattern.n_edges).run()
         seconds.append(time.perf_counter() - t0)
     return result, _meta.median(seconds)
@@ -113,6 +119,7 @@ def difference(state, entry, positions) -> dict:
 def one_file(path: Path, svgs: Path, runs: int) -> dict:
     """Every comparison of one state file (module docstring)."""
     from foldcore.io import read
+    from foldcore.sheet import build_sheet
 
     state = osl.load_state(path)
     row = {"svg": state["svg"], "nodes": int(len(state.get("nodes", []))), "folds": []}
@@ -133,7 +140,7 @@ def one_file(path: Path, svgs: Path, runs: int) -> dict:
     for entry in state["folds"]:
         if entry.get("positions_b") is None or not entry["settled"]:
             if user_pattern is not None:  # no shape to compare with: foldcore's time alone
-                result, seconds = fold(user_pattern, entry["percent"], 1)
+                result, seconds = fold(user_pattern, entry["percent"], 1, drawing=True)
                 row["folds"].append({"percent": entry["percent"], "unsettled_os": {
                     "reason": result.reason, "iterations": result.iterations,
                     "seconds": seconds}})
@@ -146,9 +153,10 @@ def one_file(path: Path, svgs: Path, runs: int) -> dict:
                             "reason": result.reason, "iterations": result.iterations,
                             "seconds": seconds}
         if nodes is not None:
-            result, seconds = fold(user_pattern, entry["percent"], runs)
+            result, seconds = fold(user_pattern, entry["percent"], runs, drawing=True)
             positions = np.empty((len(nodes), 3))
-            positions[nodes] = to_os_frame(result.positions)
+            kept = build_sheet(user_pattern, merge_straight=True).vertex_ids
+            positions[nodes] = to_os_frame(result.positions[kept])
             out["end_to_end"] = {**difference(state, entry, positions),
                                  "reason": result.reason, "iterations": result.iterations,
                                  "seconds": seconds}

@@ -138,3 +138,76 @@ def test_flat_at_zero_percent_and_stiffer_creases_meet_targets_closer():
     miss = [np.max(np.abs(f.fold_angles_deg[interior] - target[interior])) for f in (soft, stiff)]
     assert soft.converged and stiff.converged
     assert miss[1] < miss[0]
+
+
+def _with_midpoints(pattern, edges, bend=0.0):
+    """``pattern`` with a vertex added at the middle of each of ``edges`` (moved
+    ``bend`` × the edge's length off its line), each half keeping the edge's
+    assignment and target."""
+    from foldcore.pattern import CreasePattern
+
+    xy = [np.asarray(v, float) for v in pattern.vertices]
+    kept = [e for e in range(pattern.n_edges) if e not in edges]
+    new_edges = [tuple(pattern.edges[e]) for e in kept]
+    kinds = [pattern.assignments[e] for e in kept]
+    angles = [pattern.fold_angles[e] for e in kept]
+    for e in edges:
+        a, b = pattern.edges[e]
+        d = xy[b] - xy[a]
+        xy.append(0.5 * (xy[a] + xy[b]) + bend * np.array([-d[1], d[0]]))
+        m = len(xy) - 1
+        new_edges += [(a, m), (m, b)]
+        kinds += [pattern.assignments[e]] * 2
+        angles += [pattern.fold_angles[e]] * 2
+    return CreasePattern(np.array(xy), new_edges, kinds, fold_angles=angles)
+
+
+def test_a_straight_degree2_vertex_is_left_out_as_origami_simulator_does():
+    """A vertex splitting a crease or a boundary edge in two (degree 2, straight) is
+    no node of the sheet when asked, as Origami Simulator leaves it out of a drawing: the fold is the
+    unsplit pattern's, both halves report its crease's angle, and the vertex lies
+    on its merged edge. A vertex 10° off the line (|cos + 1| = 0.015) stays."""
+    sectors = (135.0, 90.0, 45.0, 90.0)
+    rho = kinematics.degree4_deg(sectors[0], sectors[1], 60.0, "A")
+    plain = patterns.single_vertex(sectors, patterns.degree4_assignments(sectors, "A"),
+                                   fold_angles=rho)
+    crease = next(e for e in range(plain.n_edges) if plain.assignments[e] != "B")
+    border = next(e for e in range(plain.n_edges) if plain.assignments[e] == "B")
+    split = _with_midpoints(plain, [crease, border])
+    sheet = build_sheet(split, merge_straight=True)
+    assert len(sheet.flat) == len(plain.vertices) and len(sheet.merged) == 2
+    whole = fold_sheet(build_sheet(plain), 100.0, pattern_edges=plain.n_edges)
+    parts = fold_sheet(sheet, 100.0, pattern_edges=split.n_edges)
+    assert parts.converged and whole.converged
+    n = len(plain.vertices)
+
+    def distances(x):
+        return np.linalg.norm(x[:, None] - x[None], axis=2)
+    # the same shape (the sheet floats free: compared up to a rigid motion)
+    assert np.allclose(distances(parts.positions[:n]), distances(whole.positions), atol=1e-6)
+    for v, a, b in sheet.merged:  # midpoints: half way along their merged edges
+        assert np.allclose(parts.positions[v], 0.5 * (parts.positions[a] + parts.positions[b]))
+    halves = [e for e in range(split.n_edges) if split.assignments[e] != "B"
+              and n - 1 < max(split.edges[e])]
+    assert len(halves) == 2
+    assert np.allclose(parts.fold_angles_deg[halves], whole.fold_angles_deg[crease],
+                       atol=EXACT_DEG)
+    bent = _with_midpoints(plain, [border], bend=np.tan(np.radians(10.0)) / 2)
+    assert len(build_sheet(bent, merge_straight=True).merged) == 0
+    assert len(build_sheet(split).merged) == 0  # kept unless asked (a FOLD file's)
+
+
+def test_a_degree2_vertex_between_two_assignments_stays():
+    """Origami Simulator merges only edges of one assignment: a straight line that
+    is a mountain on one side of a degree-2 vertex and a valley on the other keeps
+    its vertex."""
+    from foldcore.pattern import CreasePattern
+
+    xy = np.array([[0, 0], [2, 0], [2, 0.5], [2, 1], [0, 1], [0, 0.5], [1, 0.5]], float)
+    edges = [(0, 1), (1, 2), (2, 3), (3, 4), (4, 5), (5, 0), (5, 6), (6, 2)]
+    kinds = ["B"] * 6 + ["M", "V"]
+    pattern = CreasePattern(xy, edges, kinds, fold_angles=[np.nan] * 6 + [-30.0, 30.0])
+    assert len(build_sheet(pattern, merge_straight=True).merged) == 0
+    same = CreasePattern(xy, edges, ["B"] * 6 + ["V", "V"],
+                         fold_angles=[np.nan] * 6 + [30.0, 30.0])
+    assert build_sheet(same, merge_straight=True).merged.tolist() == [[6, 5, 2]]

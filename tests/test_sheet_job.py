@@ -116,3 +116,32 @@ def test_the_newton_budget_is_the_sheets_own_unless_given(miura_file, tmp_path):
         assert json.loads(report.read_text())["settings"]["max_iterations"] == 500
         short = foldcore.simulate(miura_file, solving={"max_iterations": 2})
     assert short.iterations == 2 and short.reason == "budget" and not short.converged
+
+
+def test_a_drawings_straight_degree2_vertices_are_left_out_and_said(tmp_path, capsys):
+    """An SVG whose valley line is drawn as two segments (a degree-2 vertex on a
+    straight crease): the thin sheet leaves the vertex out as Origami Simulator does
+    with a drawing, says so in one line, and the result still places it — on its
+    merged crease, which folds as one (both halves at the target)."""
+    svg = tmp_path / "split.svg"
+    svg.write_text(
+        '<svg xmlns="http://www.w3.org/2000/svg" width="100" height="100">'
+        '<rect x="0" y="0" width="100" height="100" fill="none" stroke="#000"/>'
+        '<line x1="50" y1="0" x2="50" y2="40" stroke="#00f" opacity="0.5"/>'
+        '<line x1="50" y1="40" x2="50" y2="100" stroke="#00f" opacity="0.5"/></svg>')
+    report = tmp_path / "r.json"
+    assert cli.main(["simulate", str(svg), "--report", str(report), "-o",
+                     str(tmp_path / "r.fold")]) == 0
+    err = capsys.readouterr().err
+    assert "1 vertex of degree 2 on straight lines left out" in err
+    data = json.loads(report.read_text())
+    assert data["sheet"]["merged_vertices"] == 1 and data["converged"]
+    creases = [a for a in data["fold_angles_deg"] if a is not None and abs(a) > 1.0]
+    assert len(creases) == 2 and np.allclose(creases, 90.0, atol=1e-6)
+    frame = json.loads((tmp_path / "r.fold").read_text())["file_frames"][0]
+    x = np.array(frame["vertices_coords"])
+    pattern = foldcore.io.read(svg)
+    middle = int(np.argmin(np.linalg.norm(np.asarray(pattern.vertices) - [50, 60], axis=1)))
+    ends = [int(np.argmin(np.linalg.norm(np.asarray(pattern.vertices) - p, axis=1)))
+            for p in ([50, 0], [50, 100])]
+    assert np.allclose(x[middle], 0.6 * x[ends[0]] + 0.4 * x[ends[1]], atol=1e-9)

@@ -55,7 +55,13 @@ def run_thin(job, loaded, on_start=None, callback=None):
     warnings.warn(f"{job.source}: {THIN_NOTE}", RunWarning, stacklevel=3)
     s, pattern = job.solving, loaded.pattern
     t0 = time.perf_counter()
-    sheet = build_sheet(pattern)
+    sheet = build_sheet(pattern, merge_straight=is_drawing(job.source))
+    if len(sheet.merged):
+        count = len(sheet.merged)
+        which = "1 vertex" if count == 1 else f"{count} vertices"
+        warnings.warn(f"{job.source}: {which} of degree 2 on straight lines left out of "
+                      f"the thin sheet, their edges merged, as Origami Simulator reads a "
+                      f"drawing (each follows its merged edge)", RunWarning, stacklevel=3)
     solver = SheetSolver(sheet, s.fold_percent, pattern_edges=pattern.n_edges)
     setup = time.perf_counter() - t0
     if on_start is not None:
@@ -67,6 +73,12 @@ def run_thin(job, loaded, on_start=None, callback=None):
         result, interrupted = solver.result("interrupted"), True
     result.timings_s.update(setup=setup, total=setup + result.timings_s["solve"])
     return sheet, solver, result, interrupted
+
+
+def is_drawing(source) -> bool:
+    """Whether the pattern file is an SVG drawing, whose straight degree-2 vertices
+    Origami Simulator leaves out (not a FOLD file's)."""
+    return str(source).lower().endswith(".svg")
 
 
 def newton_budget(solving) -> int:

@@ -25,7 +25,7 @@ def sheet_frame(sheet, positions: np.ndarray) -> dict:
     return {"frame_classes": ["foldedForm"], "frame_attributes": ["3D"],
             "frame_unit": "mm", "frame_parent": 0, "frame_inherit": False,
             "vertices_coords": np.asarray(positions).tolist(),
-            "faces_vertices": sheet.triangles.tolist(),
+            "faces_vertices": sheet.pattern_triangles.tolist(),
             FACE_PART_KEY: sheet.triangle_face.tolist()}
 
 
@@ -46,7 +46,8 @@ def sheet_report(fold, pattern, sheet, settings: dict) -> dict:
         "fold_angles_deg": nullable(fold.fold_angles_deg),
         "target_angles_deg": nullable(fold.target_angles_deg),
         "actuation": actuation_entries(fold, pattern),
-        "sheet": {"vertices": int(len(sheet.flat)), "triangles": int(len(sheet.triangles)),
+        "sheet": {"vertices": int(len(sheet.flat)), "merged_vertices": int(len(sheet.merged)),
+                  "triangles": int(len(sheet.triangles)),
                   "creases": int(np.count_nonzero(sprung & (sheet.hinge_edge >= 0))),
                   "facet_hinges": facets,
                   "free_hinges": int(np.count_nonzero(~sprung)),
@@ -79,7 +80,7 @@ def write_sheet_result(fold, pattern, sheet, settings: dict, *, fold_path=None, 
     if png:
         from .sheet_render import render_sheet_png
 
-        write_picture(png, lambda path: render_sheet_png(pattern, sheet.triangles,
+        write_picture(png, lambda path: render_sheet_png(pattern, sheet.pattern_triangles,
                                                          fold.positions, path),
                       written=[p for p in (fold_path, report) if p])
 

@@ -1,5 +1,14 @@
 """A crease pattern as a bar-and-hinge sheet (:class:`Sheet`), Origami Simulator's way.
 
+With ``merge_straight`` (Origami Simulator's reading of a drawing: it does
+so for SVG files, not for FOLD files), a vertex of degree 2 whose two edges
+run within about 8° of straight on (|cos + 1| < ``STRAIGHT``) and share their
+assignment is left out, its two edges merged into one (its
+``removeRedundantVertices``: vertex by vertex, in id order, each merge seen by
+the next); the merged edge's target is the mean of its edges' non-zero ones. In
+the folded sheet such a vertex lies on its merged edge where it lay in the flat
+one (the same share of its length).
+
 Each face is cut into triangles as Origami Simulator cuts it (a quadrilateral
 along its shorter diagonal, or on a tie the one through its lowest vertex id,
 which is the one Origami Simulator's face order picks; a larger face by earcut);
@@ -21,6 +30,7 @@ from ..triangulation import triangulate_polygon
 
 BAR, HINGE, TRIANGLE = 0, 1, 2
 TIE = 1e-9  # diagonals of a quadrilateral this close (relative, squared) are equal
+STRAIGHT = 0.01  # |cos + 1| of a degree-2 vertex's edges below which it is left out
 
 
 @dataclass(frozen=True)
@@ -48,10 +58,16 @@ class Sheet:
 
     Attributes
     ----------
-    flat : (N, 3) float, the flat sheet, normalised (centred, bounding radius 1)
+    flat : (N, 3) float, the flat sheet's nodes, normalised (centred, bounding radius 1)
+    vertex_ids : (N,) int, the pattern vertex of each node
+    merged : (D, 3) int, the pattern vertices left out (module docstring), in the
+        order they were, each with the two it lay between then
+    merged_at : (D,) float, where each lay between them (share of the way)
+    edge_alias : (E,) int, the pattern edge whose hinge stands for each edge (itself
+        but on a merged edge)
     centre : (2,) float, mm, the pattern point at the origin
     radius : float, mm, the pattern's bounding radius (one normalised unit)
-    triangles : (T, 3) int, counter-clockwise seen from +z
+    triangles : (T, 3) int, node ids, counter-clockwise seen from +z
     triangle_face : (T,) int, the pattern face each triangle cuts
     hinges : (H, 4) int, (a, b, c, d): the hinge a → b, c left, d right
     hinge_edge : (H,) int, the pattern edge of each hinge, −1 for a diagonal
@@ -63,6 +79,10 @@ class Sheet:
     """
 
     flat: np.ndarray
+    vertex_ids: np.ndarray
+    merged: np.ndarray
+    merged_at: np.ndarray
+    edge_alias: np.ndarray
     centre: np.ndarray
     radius: float
     triangles: np.ndarray
@@ -78,10 +98,26 @@ class Sheet:
     constants: Stiffness
 
     def to_mm(self, x: np.ndarray) -> np.ndarray:
-        """(N, 3) positions of the normalised frame in the pattern's mm."""
-        out = x * self.radius
-        out[:, :2] += self.centre
+        """(V, 3) mm, every pattern vertex, from the nodes' positions ``x`` (N, 3) in
+        the normalised frame; a vertex left out lies on its merged edge."""
+        out = np.zeros((len(self.vertex_ids) + len(self.merged), 3))
+        out[self.vertex_ids] = x * self.radius
+        out[self.vertex_ids, :2] += self.centre
+        for (v, a, b), t in zip(self.merged[::-1], self.merged_at[::-1]):
+            out[v] = (1.0 - t) * out[a] + t * out[b]
         return out
+
+    def from_mm(self, positions: np.ndarray) -> np.ndarray:
+        """(N, 3) the nodes' positions in the normalised frame from every pattern
+        vertex's ``positions`` (V, 3) mm."""
+        x = np.array(np.asarray(positions, dtype=float)[self.vertex_ids])
+        x[:, :2] -= self.centre
+        return x / self.radius
+
+    @property
+    def pattern_triangles(self) -> np.ndarray:
+        """(T, 3) int, the triangles as pattern vertex ids (for :meth:`to_mm`'s positions)."""
+        return self.vertex_ids[self.triangles]
 
 
 def face_triangles(xy: np.ndarray, loop: np.ndarray, face: int) -> np.ndarray:
@@ -144,22 +180,92 @@ def _collapsed_hinges(flat: np.ndarray, hinges: np.ndarray) -> np.ndarray:
     return tip_heights(flat, hinges).min(axis=1) < COLLAPSED
 
 
-def build_sheet(pattern: CreasePattern, stiffness: Stiffness = Stiffness()) -> Sheet:
-    """The bar-and-hinge :class:`Sheet` of ``pattern`` (module docstring)."""
+@dataclass
+class Merging:
+    """Degree-2 vertices left out (module docstring) and what stands for their edges.
+
+    Attributes
+    ----------
+    merged : (D, 3) int, each vertex left out and the two it lay between, in order
+    merged_at : (D,) float, where it lay between them (share of the way)
+    edge_alias : (E,) int, the edge standing for each edge (itself, or the first
+        edge of its merged chain)
+    edges : dict, (a, b) with a < b → the edge standing for it, every edge of the
+        sheet (merged ones included)
+    angles : (E,) float, degrees: each edge's target, a merged edge's the mean of
+        its edges' non-zero ones (NaN if none)
+    """
+
+    merged: np.ndarray
+    merged_at: np.ndarray
+    edge_alias: np.ndarray
+    edges: dict
+    angles: np.ndarray
+
+
+def merge_straight_vertices(pattern: CreasePattern, limit: float = STRAIGHT) -> Merging:
+    """The :class:`Merging` of ``pattern``'s straight degree-2 vertices, Origami
+    Simulator's rule: vertex by vertex in id order, a vertex with two neighbours
+    (as earlier merges left them) whose edges' |cos + 1| is below ``limit`` (0:
+    none), that share their assignment and whose neighbours are not joined."""
+    xy = np.asarray(pattern.vertices, dtype=float)
+    kinds = np.asarray(pattern.assignments)
+    angles = np.asarray(pattern.fold_angles, dtype=float).copy()
+    key = {}
+    neighbours = [dict() for _ in range(len(xy))]  # vertex → {neighbour: edge}
+    for e, (a, b) in enumerate(np.asarray(pattern.edges)):
+        neighbours[a][int(b)] = e
+        neighbours[b][int(a)] = e
+    alias = np.arange(pattern.n_edges)
+    merged, merged_at = [], []
+    for v in range(len(xy)):
+        if len(neighbours[v]) != 2:
+            continue
+        (a, ea), (b, eb) = neighbours[v].items()
+        u, w = xy[a] - xy[v], xy[b] - xy[v]
+        cosine = float(u @ w) / max(float(np.sqrt((u @ u) * (w @ w))), 1e-300)
+        if not abs(cosine + 1.0) < limit or kinds[ea] != kinds[eb] or b in neighbours[a]:
+            continue
+        both = [x for x in (angles[ea], angles[eb]) if x and not np.isnan(x)]
+        angles[ea] = np.mean(both) if both else angles[ea]
+        alias[alias == eb] = ea
+        del neighbours[a][v], neighbours[b][v]
+        neighbours[a][b], neighbours[b][a] = ea, ea
+        neighbours[v] = {}
+        span = xy[b] - xy[a]
+        merged.append((v, a, b))
+        merged_at.append(float((xy[v] - xy[a]) @ span / max(float(span @ span), 1e-300)))
+    for a, near in enumerate(neighbours):
+        for b, e in near.items():
+            key[(min(a, b), max(a, b))] = e
+    return Merging(np.array(merged, dtype=np.int64).reshape(-1, 3), np.array(merged_at),
+                   alias, key, angles)
+
+
+def build_sheet(pattern: CreasePattern, stiffness: Stiffness = Stiffness(),
+                merge_straight: bool = False) -> Sheet:
+    """The bar-and-hinge :class:`Sheet` of ``pattern`` (module docstring); with
+    ``merge_straight``, straight degree-2 vertices left out as Origami Simulator
+    leaves them out of a drawing."""
     xy = np.asarray(pattern.vertices, dtype=float)
     lo, hi = xy.min(axis=0), xy.max(axis=0)
     centre = 0.5 * (lo + hi)
     radius = float(np.sqrt(np.max(np.sum((xy - centre) ** 2, axis=1))))
-    flat = np.zeros((len(xy), 3))
-    flat[:, :2] = (xy - centre) / radius
-    cut = [face_triangles(xy, np.asarray(loop), f) for f, loop in enumerate(pattern.faces)]
+    merging = merge_straight_vertices(pattern, limit=STRAIGHT if merge_straight else 0.0)
+    kept = np.ones(len(xy), dtype=bool)
+    kept[merging.merged[:, 0]] = False
+    vertex_ids = np.flatnonzero(kept)
+    node = np.cumsum(kept) - 1  # pattern vertex → node (for kept vertices)
+    flat = np.zeros((len(vertex_ids), 3))
+    flat[:, :2] = (xy[vertex_ids] - centre) / radius
+    cut = [node[face_triangles(xy, loop[kept[loop]], f)]
+           for f, loop in enumerate(map(np.asarray, pattern.faces))]
     triangles = np.concatenate(cut)
     triangle_face = np.repeat(np.arange(len(cut)), [len(t) for t in cut])
     hinges, bars = _hinges(triangles)
-    edge_of = {(int(min(a, b)), int(max(a, b))): e for e, (a, b) in enumerate(pattern.edges)}
-    hinge_edge = np.array([edge_of.get((a, b), -1) for a, b in hinges[:, :2]], dtype=np.int64)
-    angles = np.asarray(pattern.fold_angles, dtype=float)
-    kinds = np.asarray(pattern.assignments)
+    hinge_edge = np.array([merging.edges.get((vertex_ids[a], vertex_ids[b]), -1)
+                           for a, b in hinges[:, :2]], dtype=np.int64)
+    angles, kinds = merging.angles, np.asarray(pattern.assignments)
     targets = np.zeros(len(hinges))
     spring = np.zeros(len(hinges))  # per-length stiffness, 0: no spring
     collapsed = _collapsed_hinges(flat, hinges)
@@ -171,15 +277,16 @@ def build_sheet(pattern: CreasePattern, stiffness: Stiffness = Stiffness()) -> S
         elif kinds[e] in ("M", "V", "F") and not np.isnan(angles[e]):
             targets[h] = np.radians(angles[e])
             spring[h] = stiffness.crease if angles[e] != 0 else stiffness.facet
-    return _assemble(flat, centre, radius, (triangles, triangle_face), hinges, hinge_edge,
-                     targets, spring, bars, stiffness)
+    return _assemble((flat, vertex_ids, merging), centre, radius, (triangles, triangle_face),
+                     hinges, hinge_edge, targets, spring, bars, stiffness)
 
 
-def _assemble(flat, centre, radius, cut, hinges, hinge_edge, targets, spring, bars,
+def _assemble(nodes_of, centre, radius, cut, hinges, hinge_edge, targets, spring, bars,
               stiffness: Stiffness) -> Sheet:
     """The :class:`Sheet` with its element arrays: bars, sprung hinges, triangles
     (``cut``: the triangles and the face of each)."""
     triangles, triangle_face = cut
+    flat, vertex_ids, merging = nodes_of
     length = np.linalg.norm(flat[bars[:, 1]] - flat[bars[:, 0]], axis=1)
     sprung = np.flatnonzero(spring > 0)
     hinge_length = np.linalg.norm(flat[hinges[sprung, 1]] - flat[hinges[sprung, 0]], axis=1)
@@ -198,5 +305,6 @@ def _assemble(flat, centre, radius, cut, hinges, hinge_edge, targets, spring, ba
     rest[nb + nh:] = _corner_angles(flat[triangles][:, :, :2])
     hinge_elements = np.full(len(hinges), -1, dtype=np.int64)
     hinge_elements[sprung] = nb + np.arange(nh)
-    return Sheet(flat, centre, radius, triangles, triangle_face, hinges, hinge_edge, nodes,
+    return Sheet(flat, vertex_ids, merging.merged, merging.merged_at, merging.edge_alias,
+                 centre, radius, triangles, triangle_face, hinges, hinge_edge, nodes,
                  sizes, kinds, k, rest, hinge_elements, stiffness)

@@ -147,7 +147,7 @@ def fold_sheet(sheet: Sheet, fold_percent: float = 100.0, start: np.ndarray | No
                tolerance: float = TOLERANCE, max_iterations: int = MAX_ITERATIONS,
                backend: str = "auto", pattern_edges: int | None = None) -> SheetFold:
     """Settle ``sheet`` at ``fold_percent`` (of every crease's target), from flat
-    or from ``start`` (N, 3) mm; see the module docstring and :class:`SheetSolver`."""
+    or from ``start`` (V, 3) mm, one per pattern vertex; see the module docstring and :class:`SheetSolver`."""
     solver = SheetSolver(sheet, fold_percent, start, backend, pattern_edges)
     return solver.run(tolerance, max_iterations)
 
@@ -159,7 +159,7 @@ class SheetSolver:
     ----------
     sheet : Sheet
     fold_percent : float, every crease's target × this / 100
-    start : (N, 3) float, mm, optional; default the flat sheet
+    start : (V, 3) float, mm, one per pattern vertex, optional; default the flat sheet
     backend : {"auto", "cholmod", "scipy"}, the sparse factorisation
     pattern_edges : int, optional, the pattern's edge count (``fold_angles_deg``'s
         length; default the largest edge id the sheet uses + 1)
@@ -174,7 +174,7 @@ class SheetSolver:
         self.sheet, self.backend, self.pattern_edges = sheet, backend, pattern_edges
         self.energy = Energy(sheet, fold_percent)
         self.assembly = Assembly(sheet)
-        self.x = sheet.flat.copy() if start is None else _normalised(sheet, start)
+        self.x = sheet.flat.copy() if start is None else sheet.from_mm(start)
         self.energy.settle_references(self.x)
         self.iterations, self.seconds = 0, 0.0
         self.unit_force = unit_force(sheet)
@@ -262,12 +262,6 @@ def unit_force(sheet: Sheet) -> float:
     return float(np.median(k / tip_heights(sheet.flat, hinges).min(axis=1)))
 
 
-def _normalised(sheet: Sheet, positions_mm: np.ndarray) -> np.ndarray:
-    x = np.array(positions_mm, dtype=float) / sheet.radius
-    x[:, :2] -= sheet.centre / sheet.radius
-    return x
-
-
 def _regularised_step(assembly: Assembly, data, gradient, mu, scale, factor, backend):
     """(step, factor, μ): the solution of (H + μ·diag(scale)) Δ = −g, raising μ until the
     matrix factors; (None, factor, μ) when it never does."""
@@ -323,6 +317,8 @@ def _fold(sheet: Sheet, energy: Energy, x, iterations, reason, residual, value, 
     driven = named & (sheet.hinge_elements >= 0)
     targets[sheet.hinge_edge[driven]] = np.degrees(
         energy.rest[sheet.hinge_elements[driven], 0])
+    alias = sheet.edge_alias[:count]
+    per_edge[:len(alias)], targets[:len(alias)] = per_edge[alias], targets[alias]
     return SheetFold(sheet.to_mm(x), per_edge, targets, angles, iterations,
                      reason == "converged", reason, residual, value, {"solve": seconds})
 
