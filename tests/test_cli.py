@@ -359,3 +359,15 @@ def test_reading_warnings_are_printed_before_the_run(fold_file, tmp_path, capsys
     lines = capsys.readouterr().err.splitlines()
     said = [i for i, line in enumerate(lines) if "no edges_foldAngle" in line]
     assert said and said[0] < lines.index("RUN STARTS"), lines
+
+
+def test_a_negative_number_in_exponent_form_is_a_value():
+    """argparse takes "-1e2" for an option unless told: a value below the sheet given
+    as users write it needs no "=" (``--ground -1e2``), and "-x" is still an option."""
+    from foldcore.cli import build_parser
+
+    args = build_parser().parse_args(["simulate", "p.fold", "--ground", "-1e2",
+                                      "--fold-percent", "-.5E+1"])
+    assert args.ground == -100.0 and args.fold_percent == -5.0
+    with pytest.raises(SystemExit):
+        build_parser().parse_args(["simulate", "p.fold", "--ground", "-e2"])

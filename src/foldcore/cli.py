@@ -4,18 +4,17 @@ OUT.png [options]``, ``foldcore export RESULT.fold --svg/--dxf/--stl OUT``,
 ``foldcore scene NAME [--out DIR] [--render]`` (the paper's scenes, :mod:`foldcore.scenes`),
 ``foldcore sweep`` / ``optimize`` (design studies on Dask, :mod:`foldcore.study.commands`).
 
-``simulate --animate OUT.gif|OUT.mp4`` also encodes the fold from 0 to
-``--fold-percent`` in ``--frames`` steps (:mod:`foldcore.animate`). ``render`` and
-``export`` rebuild the thick mesh of a FOLD written by ``simulate -o``
-(:func:`foldcore.fabrication.read_result`).
+``simulate --animate OUT.gif|OUT.mp4`` also encodes the fold from 0 to ``--fold-percent``
+in ``--frames`` steps (:mod:`foldcore.animate`). ``render`` and ``export`` rebuild the
+thick mesh of a FOLD written by ``simulate -o`` (:func:`foldcore.fabrication.read_result`).
 
-Exit codes: 0 success (a run that ends unconverged — stalled or at
---max-iterations — is a result: exit 0, ``converged: false`` with its
-``reason`` in the report and a warning line on stderr); 2 bad input, with one
-line on stderr naming the problem and no output file written (every output
-path is checked before the run, :mod:`foldcore.destinations`); 130 / 143
-interrupted by SIGINT / SIGTERM, one line, no half-written file. Warnings are
-one line per kind, with a count of the repeats.
+Exit codes: 0 success (a run that ends unconverged — stalled or at --max-iterations — is
+a result: exit 0, ``converged: false`` with its ``reason`` in the report and a warning
+line on stderr); 2 bad input, with one line on stderr naming the problem and no output
+file written (every output path is checked before the run, :mod:`foldcore.destinations`);
+130 / 143 interrupted by SIGINT / SIGTERM, one line, no half-written file. Warnings are
+one line per kind, with a count of the repeats. A negative number is a value, also in
+exponent form (``--ground -1e2``).
 """
 from __future__ import annotations
 
@@ -43,6 +42,10 @@ EXIT_BAD_INPUT = 2
 
 class _Parser(argparse.ArgumentParser):
     """argparse that reports a usage error as one line and exit code 2."""
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self._negative_number_matcher = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$")
 
     def error(self, message):
         self.exit(EXIT_BAD_INPUT, f"foldcore: error: {message} (see --help)\n")
@@ -129,8 +132,7 @@ def build_parser() -> argparse.ArgumentParser:
     _add_simulate(sub)
     _add_render(sub)
     _add_export(sub)
-    view = sub.add_parser("view", help="a self-contained interactive HTML page of a result "
-                                       "FOLD (simulate -o or --series)")
+    view = sub.add_parser("view", help="an interactive HTML page of a result FOLD")
     view.add_argument("result", help="FOLD file written by foldcore simulate -o / --series")
     view.add_argument("-o", "--output", required=True, help="HTML page to write")
     _add_scene(sub)
@@ -228,8 +230,7 @@ def _add_solving(sim) -> None:
                      help="equal (an actuated hinge weighs what a passive one does, the "
                           "paper's) or angle (actuated hinges 1000x stiffer: their angles are "
                           f"met where the model binds); default {DEFAULT_ACTUATION}")
-    sim.add_argument("--branch-floor", type=_non_negative, default=BRANCH_FLOOR_DEG,
-                     metavar="DEG",
+    sim.add_argument("--branch-floor", type=_non_negative, default=BRANCH_FLOOR_DEG, metavar="DEG",
                      help="from a flat sheet, first fold with passive M/V creases held at "
                           "least DEG degrees (0 … 180) on their assigned side, then release "
                           "them (branch selection; 0 turns it off; default "
@@ -417,8 +418,7 @@ class _Progress:
         self._bar.update(1)
         if self._bar.n % 10 == 0:
             self._bar.set_postfix_str(
-                f"step/limit {moved / (self._size_limit * sim.length_scale):.2g}",
-                refresh=False)
+                f"step/limit {moved / (self._size_limit * sim.length_scale):.2g}", refresh=False)
         return True
 
     def close(self) -> None:
@@ -574,8 +574,7 @@ def _main(argv) -> int:
         signalled = interrupts.caught(exc)
         if signalled is None:
             raise
-        print(f"foldcore: {signalled[1]}; files not yet complete were not written",
-              file=sys.stderr)
+        print(f"foldcore: {signalled[1]}; files not yet complete were not written", file=sys.stderr)
         return signalled[0]
     finally:
         if handler is not None:
