@@ -9,9 +9,14 @@ the vertices (after the best rigid alignment), in units of the run's limit
 (tolerance × size). A converged run is *false* when that move exceeds 2 limits
 and its fold angles change by more than 2 · limit / H (radians → degrees).
 
-Run: ``python tools/verdict_check.py [COUNT] [SEED] [BUDGET]`` (defaults 300, 7,
-2000; about 5 min on 2 cores); writes tools/results/verdict_check.json (one
-record per run and the counts per strategy) and prints the counts.
+With ``--units`` every problem is also folded given in µm (pattern and
+thickness × 1000) and the verdicts compared: a pair disagrees when one unit
+converges and the other does not.
+
+Run: ``python tools/verdict_check.py [--units] [COUNT] [SEED] [BUDGET]``
+(defaults 300, 7, 2000; about 5 min on 2 cores, twice that with ``--units``);
+writes tools/results/verdict_check.json (one record per run and the counts per
+strategy) and prints the counts.
 """
 from __future__ import annotations
 
@@ -39,8 +44,10 @@ def aligned_move(a: np.ndarray, b: np.ndarray) -> float:
     return float(np.abs((a - ca) @ r + cb - b).max())
 
 
-def check(problem, mesh, solver: str, budget: int) -> dict:
-    """One run and, if converged, newton's re-run from its result."""
+def check(problem, mesh, solver: str, budget: int, units: bool = False) -> dict:
+    """One run and, if converged, newton's re-run from its result; with ``units``
+    the verdict of the same problem given in µm too."""
+    from foldcore import thicken
     from foldcore.simulation import Simulation
 
     sim = Simulation(mesh, problem.pattern, solver=solver)
@@ -48,6 +55,11 @@ def check(problem, mesh, solver: str, budget: int) -> dict:
     result = sim.run(tolerance=TOLERANCE, max_iterations=budget)
     record = {"problem": problem.name, "solver": solver, "reason": result.reason,
               "iterations": result.iterations, "seconds": time.perf_counter() - start}
+    if units:
+        scaled = problem.scaled(1e3)
+        um = Simulation(thicken(scaled.pattern, scaled.thickness), scaled.pattern,
+                        solver=solver).run(tolerance=TOLERANCE, max_iterations=budget)
+        record["um_reason"] = um.reason
     if result.converged:
         limit = TOLERANCE * sim.length_scale
         again = Simulation(mesh, problem.pattern, solver="newton", branch_floor_deg=0.0)
@@ -65,22 +77,28 @@ def main() -> None:
     from foldcore import thicken
     from random_folds import problem_set
 
-    given = [int(a) for a in sys.argv[1:4]]
+    arguments = sys.argv[1:]
+    units = "--units" in arguments
+    given = [int(a) for a in arguments if a != "--units"][:3]
     count, seed, budget = given + [300, 7, 2000][len(given):]
     records = []
     for problem in problem_set(count, seed):
         mesh = thicken(problem.pattern, problem.thickness)
         for solver in SOLVERS:
-            records.append(check(problem, mesh, solver, budget))
+            records.append(check(problem, mesh, solver, budget, units))
     converged = Counter(r["solver"] for r in records if r["reason"] == "converged")
     false = Counter(r["solver"] for r in records if r.get("false"))
-    summary = {s: {"runs": count, "converged": converged[s], "false": false[s]} for s in SOLVERS}
+    differ = Counter(r["solver"] for r in records
+                     if units and (r["reason"] == "converged") != (r["um_reason"] == "converged"))
+    summary = {s: {"runs": count, "converged": converged[s], "false": false[s],
+                   **({"unit_disagreements": differ[s]} if units else {})} for s in SOLVERS}
     out = ROOT / "tools" / "results" / "verdict_check.json"
     out.write_text(json.dumps({"count": count, "seed": seed, "budget": budget,
-                               "tolerance": TOLERANCE, "summary": summary,
+                               "tolerance": TOLERANCE, "units": units, "summary": summary,
                                "runs": records}, indent=1))
     for s in SOLVERS:
-        print(f"{s:9s} converged {converged[s]:4d}  false {false[s]:3d}")
+        print(f"{s:9s} converged {converged[s]:4d}  false {false[s]:3d}"
+              + (f"  unit disagreements {differ[s]:3d}" if units else ""))
 
 
 if __name__ == "__main__":
