@@ -146,8 +146,9 @@ class Energy:
 def fold_sheet(sheet: Sheet, fold_percent: float = 100.0, start: np.ndarray | None = None,
                tolerance: float = TOLERANCE, max_iterations: int = MAX_ITERATIONS,
                backend: str = "auto", pattern_edges: int | None = None) -> SheetFold:
-    """Settle ``sheet`` at ``fold_percent`` (of every crease's target), from flat
-    or from ``start`` (V, 3) mm, one per pattern vertex; see the module docstring and :class:`SheetSolver`."""
+    """Settle ``sheet`` at ``fold_percent`` (of every crease's target), from flat or
+    from ``start`` (V, 3) mm, one per pattern vertex; see the module docstring and
+    :class:`SheetSolver`."""
     solver = SheetSolver(sheet, fold_percent, start, backend, pattern_edges)
     return solver.run(tolerance, max_iterations)
 
