@@ -97,3 +97,20 @@ def test_view_refuses_what_it_cannot_show_in_one_line(tmp_path, capsys):
     lines = capsys.readouterr().err.splitlines()
     assert len(lines) == 2 and all(line.startswith("foldcore: error: ") for line in lines)
     assert not (tmp_path / "v.html").exists()
+
+
+def test_a_thin_sheets_result_shows_its_folded_triangles(tmp_path):
+    """A result folded with no thickness (the thin sheet) has no thick mesh to rebuild:
+    ``view`` shows its folded triangles (facets, grey) instead of refusing it, while
+    ``render`` and ``export`` still say they read thick results."""
+    result, page = tmp_path / "wb.fold", tmp_path / "wb.html"
+    assert main(["simulate", "tests/data/real/waterbombBase.svg", "--fold-percent", "80",
+                 "-o", str(result), "-q"]) == 0
+    assert main(["view", str(result), "-o", str(page)]) == 0
+    dom = chromium(f"file://{page}", f"--user-data-dir={tmp_path / 'profile'}",
+                   "--dump-dom").stdout
+    assert 'data-ready="yes"' in dom and 'data-frames="1"' in dom, dom[-500:]
+    image = screenshot(page, tmp_path, "frame=0")
+    assert int((image.sum(axis=2) < 740).sum()) > 1000  # the sheet is drawn
+    assert count(image, "red") == count(image, "blue") == 0  # facets only: grey
+    assert main(["export", str(result), "--stl", str(tmp_path / "wb.stl")]) == 2

@@ -119,7 +119,40 @@ class ResultFile:
                 f"> {limit:.3g} mm); pass the thickening.hinge_width used with simulate")
 
 
-def read_result(path, hinge_width=None, subdivisions=None) -> ResultFile:
+@dataclass(frozen=True)
+class SheetResultFile:
+    """A thin sheet's result file (``foldcore:model`` "sheet"), checked.
+
+    Attributes
+    ----------
+    pattern : CreasePattern
+    frames : tuple of FoldedFrame, each folded frame (positions: one per pattern
+        vertex, mm)
+    triangles : (T, 3) int, the last folded frame's triangles (pattern vertex ids)
+    source : str
+    """
+
+    pattern: object
+    frames: tuple
+    triangles: np.ndarray
+    source: str
+
+
+def _sheet_result(fold, frames, faces, source: str) -> SheetResultFile:
+    """The :class:`SheetResultFile` of a thin sheet's checked frames: one position per
+    pattern vertex, faces that are triangles."""
+    n = fold.pattern.n_vertices
+    if len(frames[-1].positions) != n:
+        fail(source, f"file_frames[{frames[-1].index}] has {len(frames[-1].positions)} "
+                     f"vertices, the pattern {n}: not a thin sheet's folded form")
+    if not faces or any(len(f) != 3 for f in faces):
+        fail(source, f"file_frames[{frames[-1].index}]: a thin sheet's folded form is "
+                     "triangles (faces_vertices of 3 vertex ids each)")
+    return SheetResultFile(fold.pattern, tuple(frames), np.array(faces, dtype=np.int64),
+                           source)
+
+
+def read_result(path, hinge_width=None, subdivisions=None, thin: bool = False):
     """Read a FOLD result (``foldcore simulate -o``) and rebuild its thick mesh.
 
     The file holds the crease pattern (with ``foldcore:thickness`` and the
@@ -132,7 +165,9 @@ def read_result(path, hinge_width=None, subdivisions=None) -> ResultFile:
     The stored coordinates are then the positions of the rebuilt mesh: panels,
     sub-strips and their creases (M/V) are all known. The mesh is matched to
     the last folded frame; every folded frame is checked (module docstring)
-    and kept in ``frames``.
+    and kept in ``frames``. With ``thin``, a thin sheet's result (``foldcore:model``
+    "sheet") is read as a :class:`SheetResultFile` (its frames, checked, and its
+    triangles) instead of refused.
 
     Parameters
     ----------
@@ -162,9 +197,11 @@ def read_result(path, hinge_width=None, subdivisions=None) -> ResultFile:
     fold = fold_file_from_dict(d, source)
     frames, faces = _folded_frames(d, fold.pattern.n_edges, source)
     if fold.thickness is None and d.get(MODEL_KEY) == "sheet":
+        if thin:
+            return _sheet_result(fold, frames, faces, source)
         raise PatternError(f"{source}: a thin sheet's result (folded with no thickness): "
-                           "render, view and export read thick results; its folded form "
-                           "is the file's foldedForm frame, for any FOLD viewer")
+                           "render and export read thick results; view shows it, and its "
+                           "folded form is the file's foldedForm frame, for any FOLD viewer")
     if fold.thickness is None:
         raise PatternError(f"{source}: no foldcore:thickness; not a foldcore result file")
     for frame in frames:

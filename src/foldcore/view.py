@@ -12,7 +12,9 @@ strain (dark to yellow, 0 to the largest over the frames; as ``foldcore render
 --color-by strain``). ``#frame=K&colour=angle`` in the URL
 chooses the first view (used by the tests). Geometry: the outer surface of
 the thick mesh rebuilt from the file (:func:`foldcore.result_file.read_result`),
-float32 positions per frame, base64-encoded.
+float32 positions per frame, base64-encoded. A thin sheet's result (no
+thickness) shows its folded triangles, all as facets (grey: it has no hinge
+strips to colour), with each crease's angle in the frames' data.
 
 Nothing from the file becomes markup or script: the values are those
 ``read_result`` checked (types, shapes, ranges), they reach the page only as
@@ -59,8 +61,13 @@ def view_html(path, output) -> None:
     from .result_file import read_result
     from .surface import surface_triangles
 
+    from .result_file import SheetResultFile
+
     source = os.fspath(path)
-    res = read_result(source)
+    res = read_result(source, thin=True)
+    if isinstance(res, SheetResultFile):
+        write_text(output, _page(source, _sheet_data(res)))
+        return
     surface = surface_polygons(res.mesh)
     triangles, face = surface_triangles(res.mesh, surface, return_faces=True, source=source)
     crease = np.where(surface.is_hinge[face], surface.source[face], -1).astype(np.int32)
@@ -73,6 +80,17 @@ def view_html(path, output) -> None:
             "crease": _b64(crease.astype("<i4")), "strip": _b64(strip),
             "frames": [_page_frame(frame, res.mesh) for frame in res.frames]}
     write_text(output, _page(source, data))
+
+
+def _sheet_data(res) -> dict:
+    """The page's data of a thin sheet's result: its triangles, all facets (kind 0,
+    no crease or strip), and per frame its positions, no strains and its angles."""
+    count = len(res.triangles)
+    none = np.full(count, -1, dtype="<i4")
+    return {"triangles": _b64(res.triangles.astype("<u4")),
+            "kind": _b64(np.zeros(count, dtype=np.uint8)), "crease": _b64(none),
+            "strip": _b64(none), "frames": [_frame_entry(frame, np.zeros(0))
+                                            for frame in res.frames]}
 
 
 def _page(source: str, data: dict) -> str:
@@ -111,8 +129,13 @@ def _page_frame(frame, mesh) -> dict:
     """The page's entry of one :class:`~foldcore.result_file.FoldedFrame`: title,
     (N·3) float32 positions and (S,) float32 sub-strip strains (base64), and the
     achieved angle per crease (degrees, null where none)."""
+    return _frame_entry(frame, _strip_strains(mesh, frame.positions))
+
+
+def _frame_entry(frame, strains: np.ndarray) -> dict:
+    """One frame's entry of the page: title, positions, ``strains`` (S,), angles."""
     return {"title": frame.title, "xyz": _b64(frame.positions.astype("<f4")),
-            "strain": _b64(_strip_strains(mesh, frame.positions).astype("<f4")),
+            "strain": _b64(strains.astype("<f4")),
             "angles": [None if np.isnan(a) else float(a) for a in frame.angles.tolist()]}
 
 
