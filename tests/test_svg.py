@@ -125,11 +125,25 @@ def test_lines_whose_type_contradicts_their_sides_are_read_as_origami_simulator_
     assert any("read as free hinges (U)" in n for n in notes)
 
 
+def test_lines_drawn_over_each_other_read_as_origami_simulator_keeps_them(tmp_path):
+    """Two crease types on one line: Origami Simulator keeps the type its reader lists
+    first (B, M, V, F, U), whatever the file order; two angles of one type, the first
+    in the file. Said once, with the count and what was kept over what."""
+    valley_then_mountain = ('<line x1="50" y1="0" x2="50" y2="100" stroke="#00f"/>'
+                            '<line x1="50" y1="0" x2="50" y2="100" stroke="#f00"/>')
+    pattern, said = read_text(tmp_path, svg(SQUARE + valley_then_mountain))
+    assert crease_set(pattern) == {("M", -180.0): 1}
+    (message,) = [m for m in said if "Origami Simulator's order" in m]
+    assert "1 pieces" in message and "M over V" in message
+    half_then_full = ('<line x1="50" y1="0" x2="50" y2="100" stroke="#f00" opacity="0.5"/>'
+                      '<line x1="50" y1="0" x2="50" y2="100" stroke="#f00"/>')
+    pattern, said = read_text(tmp_path, svg(SQUARE + half_then_full))
+    assert crease_set(pattern) == {("M", -90.0): 1}
+    assert any("M over M" in m for m in said)
+
+
 @pytest.mark.parametrize("body, needles", [
     ('<line x1="50" y1="0" x2="50" y2="100" stroke="#0f0"/>', ["line", "cut"]),
-    ('<line x1="50" y1="0" x2="50" y2="100" stroke="#f00"/>'
-     '<line id="b" x1="50" y1="0" x2="50" y2="100" stroke="#00f"/>',
-     ["'b'", "overlap", "different"]),
 ])
 def test_what_foldcore_cannot_fold_is_refused_naming_the_element(tmp_path, body, needles):
     with pytest.raises(PatternError) as info:

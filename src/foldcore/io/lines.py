@@ -7,11 +7,13 @@ snaps endpoints within ``tol`` onto nearby segments (T-joins drawn a little
 short or long), nodes every crossing and overlap into a shared vertex
 (shapely's unary union), merges vertices within ``tol`` and types each piece
 by the segments it lies along (two different types on one piece are
-refused, naming both owners). Bounds checked before the work: at most
+refused, naming both owners; in an SVG the one Origami Simulator keeps). Bounds checked before the work: at most
 :data:`MAX_MEETINGS` meetings of segments and :data:`MAX_CLOSE_PAIRS` close
 pairs of noded points.
 """
 from __future__ import annotations
+
+from collections import Counter
 
 import numpy as np
 
@@ -28,6 +30,10 @@ MAX_CLOSE_PAIRS = 1_000_000
 #: A piece lies along a segment if the sine of the angle between them is at most this
 #: (a piece near a crossing is near both segments but along one).
 PARALLEL = 0.1
+#: Which of two crease types drawn over each other Origami Simulator keeps: the one
+#: its SVG reader lists first (it reads borders, then mountains, valleys, facet
+#: lines, hinges and cuts, and drops the later of two equal edges).
+OVERLAP_ORDER = ("B", "M", "V", "F", "U", "C")
 
 
 def pattern_from_lines(segments: np.ndarray, kinds, angles, owners, source: str, *,
@@ -50,13 +56,23 @@ def pattern_from_lines(segments: np.ndarray, kinds, angles, owners, source: str,
     where : callable(x, y) -> str, optional
         A place in the file's words, for messages (default ``(x, y)``).
     sides_as_origami_simulator : bool
-        Lines whose type contradicts their sides read as Origami Simulator reads
-        them (:func:`sides_read_as_origami_simulator`) instead of refused.
+        Lines whose type contradicts their sides, and lines of different types or
+        angles drawn over each other, read as Origami Simulator reads them
+        (:func:`sides_read_as_origami_simulator`; :data:`OVERLAP_ORDER`) instead
+        of refused.
     """
     vertices, edges, pieces = planarise(segments, tol, source)
     extra = {} if where is None else {"where": where}
+    if sides_as_origami_simulator:
+        extra["overlaps"] = Counter()
     assignments, fold_angles = piece_types(pieces, edges, vertices, segments, kinds,
                                            angles, owners, tol, source, **extra)
+    if extra.get("overlaps"):
+        found = extra["overlaps"]
+        note(source, f"{sum(found.values())} pieces drawn as two crease types or angles "
+                     f"read as the first in Origami Simulator's order "
+                     f"({' '.join(OVERLAP_ORDER)}, then file order): "
+                     + ", ".join(f"{k} over {v}" for (k, v) in sorted(found)))
     if sides_as_origami_simulator:
         assignments, fold_angles = sides_read_as_origami_simulator(
             vertices, edges, assignments, fold_angles, source)
@@ -206,11 +222,13 @@ def _snap_endpoints(segments: np.ndarray, tol: float) -> np.ndarray:
 
 
 def piece_types(pieces, edges, vertices, segments, kinds, angles, owners, tol, source,
-                where=lambda x, y: f"({x:g}, {y:g})"):
+                where=lambda x, y: f"({x:g}, {y:g})", overlaps=None):
     """Each piece's assignment and target: those of the segments it lies along — its
     midpoint within ``tol`` and both ends within 2 ``tol`` of the segment, and its
     direction within ``PARALLEL`` (sine) of the segment's; two different ones are
-    refused (``where(x, y)``: the place in the file's words). A piece near a crossing
+    refused (``where(x, y)``: the place in the file's words), or with ``overlaps``
+    (a Counter) the first in :data:`OVERLAP_ORDER`, then in file order, is kept as
+    Origami Simulator keeps it, and (kept, dropped) counted. A piece near a crossing
     is also near the crossing segment but not along it; a short piece whose merged
     ends turned it by more is typed by the segment closest to its direction, one
     whose ends merged farther by the nearest segment."""
@@ -238,6 +256,12 @@ def piece_types(pieces, edges, vertices, segments, kinds, angles, owners, tol, s
                                                   or target[p] == angles[s])
             if owner[p] is None:
                 assignment[p], target[p], owner[p] = kinds[s], angles[s], owners[s]
+                first = s
+            elif not same and overlaps is not None:
+                keep, drop = sorted((first, s), key=lambda q: (_rank(kinds[q]), q))
+                overlaps[(kinds[keep], kinds[drop])] += 1
+                assignment[p], target[p], owner[p] = kinds[keep], angles[keep], owners[keep]
+                first = keep
             elif not same:
                 raise PatternError(f"{source}: {owners[s]} and {owner[p]} overlap with "
                                    f"different crease types or angles ({kinds[s]} and "
@@ -246,6 +270,11 @@ def piece_types(pieces, edges, vertices, segments, kinds, angles, owners, tol, s
         s = int(tree.query_nearest(shapely.points(ends[p].mean(axis=0)))[0])
         assignment[p], target[p] = kinds[s], angles[s]
     return assignment.tolist(), [None if np.isnan(t) else float(t) for t in target]
+
+
+def _rank(kind: str) -> int:
+    """A crease type's place in :data:`OVERLAP_ORDER` (unknown types last)."""
+    return OVERLAP_ORDER.index(kind) if kind in OVERLAP_ORDER else len(OVERLAP_ORDER)
 
 
 def _unit(d: np.ndarray) -> np.ndarray:
