@@ -450,19 +450,19 @@ def _why(result) -> str:
 
 
 def render_result(args) -> int:
-    """Run ``foldcore render``; raises FoldcoreError on bad input.
-
-    The thick mesh is rebuilt from the file (:func:`foldcore.result_file.read_result`)
-    rather than the stored surface drawn as it is: the stored faces carry no
-    panel/hinge or mountain/valley information, the rebuilt mesh does, and it
-    is accepted only when its surface equals the stored one.
-    """
-    from .result_file import read_result
+    """Run ``foldcore render``; raises FoldcoreError on bad input. The thick mesh is
+    rebuilt from the file (:func:`foldcore.result_file.read_result`): its stored faces
+    carry no panel/hinge or M/V information. A thin sheet's result is drawn from
+    its triangles (:func:`foldcore.sheet_render.render_sheet_result`)."""
+    from .result_file import SheetResultFile, read_result
     from .measure import fold_angles
     from .render import colour_limits, per_strip, render_png, strip_bend_angles
 
     check_destinations({"-o": args.output}, inputs=(args.result,), suffixes={"-o": (".png",)})
-    res = read_result(args.result, args.hinge_width, args.subdivisions)
+    res = read_result(args.result, args.hinge_width, args.subdivisions, thin=True)
+    if isinstance(res, SheetResultFile):
+        from .sheet_render import render_sheet_result
+        return render_sheet_result(res, args.output, args.size, args.view, args.color_by)
     options = {}
     if args.color_by == "strain":   # largest surface tension of each sub-strip
         from .strain import strains_at

@@ -200,7 +200,7 @@ def read_result(path, hinge_width=None, subdivisions=None, thin: bool = False):
         if thin:
             return _sheet_result(fold, frames, faces, source)
         raise PatternError(f"{source}: a thin sheet's result (folded with no thickness): "
-                           "render and export read thick results; view shows it, and its "
+                           "export reads thick results; render and view show it, and its "
                            "folded form is the file's foldedForm frame, for any FOLD viewer")
     if fold.thickness is None:
         raise PatternError(f"{source}: no foldcore:thickness; not a foldcore result file")

@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 
 from . import files
+from .errors import PatternError
 from .files import ExportError
 from .render import (BACKGROUND, EDGE_COLOUR, HINGE_COLOURS, PANEL_COLOUR, behind_lines,
                      check_size, fit_camera, require_pyvista, view_vectors)
@@ -53,3 +54,23 @@ def render_sheet_png(pattern, triangles, positions, path, size=(1024, 768), view
             plotter.screenshot(tmp)
     finally:
         plotter.close()
+
+
+def render_sheet_result(result, path, size=(1024, 768), view="iso", color_by: str = "none"):
+    """``foldcore render`` of a thin sheet's result file (a
+    :class:`~foldcore.result_file.SheetResultFile`): its last folded frame's
+    triangles, creases in their assignment colours (:func:`render_sheet_png`).
+
+    Raises
+    ------
+    PatternError
+        ``color_by`` other than "none": the colourings are of a thick sheet's
+        hinge strips, which a thin sheet has not.
+    """
+    if color_by != "none":
+        raise PatternError(f"{result.source}: --color-by {color_by} colours a thick sheet's "
+                           "hinge strips; a thin sheet's result is drawn with its creases "
+                           "in their assignment colours (--color-by none)")
+    render_sheet_png(result.pattern, result.triangles, result.frames[-1].positions, path,
+                     size=size, view=view)
+    return 0
