@@ -13,8 +13,9 @@ strain (dark to yellow, 0 to the largest over the frames; as ``foldcore render
 chooses the first view (used by the tests). Geometry: the outer surface of
 the thick mesh rebuilt from the file (:func:`foldcore.result_file.read_result`),
 float32 positions per frame, base64-encoded. A thin sheet's result (no
-thickness) shows its folded triangles, all as facets (grey: it has no hinge
-strips to colour), with each crease's angle in the frames' data.
+thickness) shows its folded triangles as grey facets with its creases drawn
+over them as lines, coloured by assignment or by their angle (it has no hinge
+strips to strain).
 
 Nothing from the file becomes markup or script: the values are those
 ``read_result`` checked (types, shapes, ranges), they reach the page only as
@@ -84,13 +85,20 @@ def view_html(path, output) -> None:
 
 def _sheet_data(res) -> dict:
     """The page's data of a thin sheet's result: its triangles, all facets (kind 0,
-    no crease or strip), and per frame its positions, no strains and its angles."""
+    no crease or strip); its pattern's edges as lines (``lines``, ``line_kind``: 0
+    boundary, else as :data:`KINDS`, ``line_crease``: the edge, −1 on the boundary)
+    drawn over them; per frame its positions, no strains and its angles."""
     count = len(res.triangles)
     none = np.full(count, -1, dtype="<i4")
+    kinds = [str(k) for k in res.pattern.assignments]
+    line_kind = np.array([0 if k == "B" else KINDS.get(k, 4) for k in kinds], dtype=np.uint8)
+    line_crease = np.where(line_kind > 0, np.arange(len(kinds)), -1).astype("<i4")
     return {"triangles": _b64(res.triangles.astype("<u4")),
             "kind": _b64(np.zeros(count, dtype=np.uint8)), "crease": _b64(none),
-            "strip": _b64(none), "frames": [_frame_entry(frame, np.zeros(0))
-                                            for frame in res.frames]}
+            "strip": _b64(none),
+            "lines": _b64(np.asarray(res.pattern.edges, dtype="<u4")),
+            "line_kind": _b64(line_kind), "line_crease": _b64(line_crease),
+            "frames": [_frame_entry(frame, np.zeros(0)) for frame in res.frames]}
 
 
 def _page(source: str, data: dict) -> str:
