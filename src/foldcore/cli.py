@@ -462,7 +462,8 @@ def render_result(args) -> int:
     res = read_result(args.result, args.hinge_width, args.subdivisions, thin=True)
     if isinstance(res, SheetResultFile):
         from .sheet_render import render_sheet_result
-        return render_sheet_result(res, args.output, args.size, args.view, args.color_by)
+        render_sheet_result(res, args.output, args.size, args.view, args.color_by)
+        return 0
     options = {}
     if args.color_by == "strain":   # largest surface tension of each sub-strip
         from .strain import strains_at

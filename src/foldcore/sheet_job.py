@@ -55,7 +55,7 @@ def run_thin(job, loaded, on_start=None, callback=None):
     warnings.warn(f"{job.source}: {THIN_NOTE}", RunWarning, stacklevel=3)
     s, pattern = job.solving, loaded.pattern
     t0 = time.perf_counter()
-    sheet = build_sheet(pattern, merge_straight=is_drawing(job.source))
+    sheet = build_sheet(pattern, merge_straight=loaded.drawing)
     if len(sheet.merged):
         count = len(sheet.merged)
         which = "1 vertex" if count == 1 else f"{count} vertices"
@@ -73,12 +73,6 @@ def run_thin(job, loaded, on_start=None, callback=None):
         result, interrupted = solver.result("interrupted"), True
     result.timings_s.update(setup=setup, total=setup + result.timings_s["solve"])
     return sheet, solver, result, interrupted
-
-
-def is_drawing(source) -> bool:
-    """Whether the pattern file is an SVG drawing, whose straight degree-2 vertices
-    Origami Simulator leaves out (not a FOLD file's)."""
-    return str(source).lower().endswith(".svg")
 
 
 def newton_budget(solving) -> int:

@@ -56,7 +56,8 @@ def render_sheet_png(pattern, triangles, positions, path, size=(1024, 768), view
         plotter.close()
 
 
-def render_sheet_result(result, path, size=(1024, 768), view="iso", color_by: str = "none"):
+def render_sheet_result(result, path, size=(1024, 768), view="iso",
+                        color_by: str = "none") -> None:
     """``foldcore render`` of a thin sheet's result file (a
     :class:`~foldcore.result_file.SheetResultFile`): its last folded frame's
     triangles, creases in their assignment colours (:func:`render_sheet_png`).
@@ -73,4 +74,3 @@ def render_sheet_result(result, path, size=(1024, 768), view="iso", color_by: st
                            "in their assignment colours (--color-by none)")
     render_sheet_png(result.pattern, result.triangles, result.frames[-1].positions, path,
                      size=size, view=view)
-    return 0

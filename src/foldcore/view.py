@@ -59,10 +59,8 @@ def view_html(path, output) -> None:
     """
     from .files import write_text
     from .mesh import surface_polygons
-    from .result_file import read_result
+    from .result_file import SheetResultFile, read_result
     from .surface import surface_triangles
-
-    from .result_file import SheetResultFile
 
     source = os.fspath(path)
     res = read_result(source, thin=True)

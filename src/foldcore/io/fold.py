@@ -92,6 +92,10 @@ class FoldFile:
     hinge : list of str or None, or None
         Hinge model per edge from ``foldcore:edges_hinge`` (None entries:
         the default), ready for ``thicken(..., hinge=...)``; None when absent.
+    drawing : bool
+        Read from an SVG drawing: a thin sheet leaves out its straight degree-2
+        vertices, as Origami Simulator does with a drawing and not with a FOLD
+        file (:func:`foldcore.sheet.build_sheet`'s ``merge_straight``).
     """
 
     pattern: CreasePattern
@@ -99,6 +103,7 @@ class FoldFile:
     frame_unit: str
     stiffness: dict | None = None
     hinge: list | None = None
+    drawing: bool = False
 
 
 # ------------------------------------------------------------------- reading

@@ -7,9 +7,9 @@ snaps endpoints within ``tol`` onto nearby segments (T-joins drawn a little
 short or long), nodes every crossing and overlap into a shared vertex
 (shapely's unary union), merges vertices within ``tol`` and types each piece
 by the segments it lies along (two different types on one piece are
-refused, naming both owners; in an SVG the one Origami Simulator keeps). Bounds checked before the work: at most
-:data:`MAX_MEETINGS` meetings of segments and :data:`MAX_CLOSE_PAIRS` close
-pairs of noded points.
+refused, naming both owners; in an SVG, the one Origami Simulator keeps).
+Bounds checked before the work: at most :data:`MAX_MEETINGS` meetings of
+segments and :data:`MAX_CLOSE_PAIRS` close pairs of noded points.
 """
 from __future__ import annotations
 
@@ -63,16 +63,15 @@ def pattern_from_lines(segments: np.ndarray, kinds, angles, owners, source: str,
     """
     vertices, edges, pieces = planarise(segments, tol, source)
     extra = {} if where is None else {"where": where}
-    if sides_as_origami_simulator:
-        extra["overlaps"] = Counter()
+    overlaps = Counter() if sides_as_origami_simulator else None
     assignments, fold_angles = piece_types(pieces, edges, vertices, segments, kinds,
-                                           angles, owners, tol, source, **extra)
-    if extra.get("overlaps"):
-        found = extra["overlaps"]
-        note(source, f"{sum(found.values())} pieces drawn as two crease types or angles "
+                                           angles, owners, tol, source, overlaps=overlaps,
+                                           **extra)
+    if overlaps:
+        note(source, f"{sum(overlaps.values())} pieces drawn as two crease types or angles "
                      f"read as the first in Origami Simulator's order "
                      f"({' '.join(OVERLAP_ORDER)}, then file order): "
-                     + ", ".join(f"{k} over {v}" for (k, v) in sorted(found)))
+                     + ", ".join(f"{k} over {v}" for (k, v) in sorted(overlaps)))
     if sides_as_origami_simulator:
         assignments, fold_angles = sides_read_as_origami_simulator(
             vertices, edges, assignments, fold_angles, source)

@@ -211,7 +211,7 @@ def merge_straight_vertices(pattern: CreasePattern, limit: float = STRAIGHT) -> 
     xy = np.asarray(pattern.vertices, dtype=float)
     kinds = np.asarray(pattern.assignments)
     angles = np.asarray(pattern.fold_angles, dtype=float).copy()
-    key = {}
+    edges = {}  # (a, b), a < b → the edge standing for it
     neighbours = [dict() for _ in range(len(xy))]  # vertex → {neighbour: edge}
     for e, (a, b) in enumerate(np.asarray(pattern.edges)):
         neighbours[a][int(b)] = e
@@ -237,9 +237,9 @@ def merge_straight_vertices(pattern: CreasePattern, limit: float = STRAIGHT) -> 
         merged_at.append(float((xy[v] - xy[a]) @ span / max(float(span @ span), 1e-300)))
     for a, near in enumerate(neighbours):
         for b, e in near.items():
-            key[(min(a, b), max(a, b))] = e
+            edges[(min(a, b), max(a, b))] = e
     return Merging(np.array(merged, dtype=np.int64).reshape(-1, 3), np.array(merged_at),
-                   alias, key, angles)
+                   alias, edges, angles)
 
 
 def build_sheet(pattern: CreasePattern, stiffness: Stiffness = Stiffness(),
