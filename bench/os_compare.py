@@ -77,19 +77,20 @@ def normalised(xy: np.ndarray) -> np.ndarray:
 
 
 def match(pattern, state: dict):
-    """(Origami Simulator's node of each node of foldcore's sheet, largest gap) or
-    (None, gap): the sheet leaves out straight degree-2 vertices as Origami
-    Simulator does, so its nodes, not the pattern's vertices, are matched."""
+    """((the pattern vertex of each node of foldcore's sheet, Origami Simulator's node
+    of each), largest gap) or (None, gap): the sheet leaves out straight degree-2
+    vertices as Origami Simulator does, so its nodes, not the pattern's vertices,
+    are matched."""
     from scipy.spatial import cKDTree
     from foldcore.sheet import build_sheet
 
     theirs = normalised(state["fold"]["vertices_coords"][:, [0, 2]] * [1.0, -1.0])
     vertices = np.asarray(pattern.vertices, dtype=float)
-    mine = normalised(vertices)[build_sheet(pattern, merge_straight=True).vertex_ids]
-    gap, idx = cKDTree(theirs).query(mine)
+    kept = build_sheet(pattern, merge_straight=True).vertex_ids
+    gap, idx = cKDTree(theirs).query(normalised(vertices)[kept])
     gap = float(gap.max())
     one_to_one = len(idx) == len(theirs) and len(np.unique(idx)) == len(idx)
-    return (idx if gap <= MATCH and one_to_one else None), gap
+    return ((kept, idx) if gap <= MATCH and one_to_one else None), gap
 
 
 def fold(pattern, percent: float, runs: int, drawing: bool = False):
@@ -119,7 +120,6 @@ def difference(state, entry, positions) -> dict:
 def one_file(path: Path, svgs: Path, runs: int) -> dict:
     """Every comparison of one state file (module docstring)."""
     from foldcore.io import read
-    from foldcore.sheet import build_sheet
 
     state = osl.load_state(path)
     row = {"svg": state["svg"], "nodes": int(len(state.get("nodes", []))), "folds": []}
@@ -154,9 +154,9 @@ def one_file(path: Path, svgs: Path, runs: int) -> dict:
                             "seconds": seconds}
         if nodes is not None:
             result, seconds = fold(user_pattern, entry["percent"], runs, drawing=True)
-            positions = np.empty((len(nodes), 3))
-            kept = build_sheet(user_pattern, merge_straight=True).vertex_ids
-            positions[nodes] = to_os_frame(result.positions[kept])
+            kept, theirs = nodes
+            positions = np.empty((len(theirs), 3))
+            positions[theirs] = to_os_frame(result.positions[kept])
             out["end_to_end"] = {**difference(state, entry, positions),
                                  "reason": result.reason, "iterations": result.iterations,
                                  "seconds": seconds}
