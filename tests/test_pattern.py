@@ -189,9 +189,20 @@ def test_zero_length_edge_coincident_vertices():
     refused("edge", 7, vertices=v, edges=SQ_E + [(5, 6), (6, 0)], assignments=SQ_A + ["V", "V"])
 
 
-def test_dangling_edge():
+def test_a_crease_ending_inside_a_face_is_a_pattern_that_a_thick_sheet_refuses():
+    """A crease from a corner to a point inside a face (a dangling crease): a thin sheet
+    folds it as Origami Simulator does; a thick sheet has no panel for it to end in.
+    A dangling boundary edge is refused."""
+    from foldcore import thicken
+
     v = SQ_V + [(5, 5)]
-    refused("edge", 7, vertices=v, edges=SQ_E + [(0, 6)], assignments=SQ_A + ["V"])
+    pattern = make(vertices=v, edges=SQ_E + [(0, 6)], assignments=SQ_A + ["V"])
+    assert pattern.dangling.tolist() == [7]
+    assert pattern.edge_faces[7, 0] == pattern.edge_faces[7, 1] >= 0  # one face, both sides
+    with pytest.raises(PatternError, match=r"edge 7 is a crease that ends inside a face"):
+        thicken(pattern, 1.0)
+    msg = refused("edge", 7, vertices=v, edges=SQ_E + [(0, 6)], assignments=SQ_A + ["B"])
+    assert "only a crease may end inside a face" in msg
 
 
 def test_isolated_vertex():
@@ -241,14 +252,15 @@ def test_disconnected_pattern_given_faces():
     assert pattern.pieces == 2 and len(pattern.faces) == len(SQ_F) + 1
 
 
-def test_disconnected_pattern_nested_in_hole():
-    # a small square floating inside the frame's hole
+def test_a_piece_inside_a_hole_of_another_is_apart_from_it():
+    # a small square floating inside the frame's hole: two pieces, neither on the other
     v, e, a = frame()
     v = v + [(13, 13), (17, 13), (17, 17), (13, 17)]
     e = e + [(8, 9), (9, 10), (10, 11), (11, 8)]
-    msg = refused("(?:vertex|edge)", r"(?:8|9|1[0-5])", vertices=v, edges=e,
-                  assignments=a + ["B"] * 4)
-    assert "inside another piece" in msg
+    pattern = make(vertices=v, edges=e, assignments=a + ["B"] * 4)
+    assert pattern.pieces == 2
+    assert sorted(len(f) for f in pattern.faces)[-1] == 4  # the hole is no face
+    assert abs(pattern.area() - (30 * 30 - 10 * 10 + 4 * 4)) < 1e-9
 
 
 # ---------------------------------------------------- malformed edge data
@@ -259,12 +271,61 @@ def test_unknown_assignment(kind):
     refused("edge", 6, assignments=a)
 
 
-@pytest.mark.parametrize("kind", ["C", "J"])
-def test_cut_and_join_refused(kind):
+def test_join_refused():
     a = list(SQ_A)
-    a[6] = kind
+    a[6] = "J"
     msg = refused("edge", 6, assignments=a)
-    assert repr(kind) in msg
+    assert "'J'" in msg
+
+
+def test_a_cut_across_the_sheet_splits_it_in_two_pieces():
+    """The square's middle line as a cut: each of its ends gets a second vertex, the cut
+    a second side; both sides boundary; said once."""
+    a = list(SQ_A)
+    a[6] = "C"
+    with pytest.warns(PatternWarning, match=r"1 cut edge \('C'\).*2 vertex copies"):
+        pattern = make(assignments=a)
+    assert pattern.n_vertices == len(SQ_V) + 2 and pattern.n_edges == len(SQ_E) + 1
+    assert pattern.pieces == 2 and set(pattern.assignments) == {"B"}
+    assert pattern.copied_from.tolist() == [4, 5]
+    sides = pattern.edges[[6, len(SQ_E)]]
+    assert np.array_equal(pattern.vertices[sides[0]], pattern.vertices[sides[1]])
+    assert not set(sides[0]) & set(sides[1])  # no vertex shared: the sheet is apart
+    assert (pattern.edge_faces[[6, len(SQ_E)]] >= 0).sum() == 2  # one face each
+    again = pattern.replace(fold_angles=pattern.fold_angles)  # the split re-validates
+    assert again.n_vertices == pattern.n_vertices
+
+
+def test_a_cut_ending_inside_the_sheet_keeps_its_end_and_a_lone_segment_stays_shut():
+    """A cut from the border to the centre of a 2 × 2 grid: its border end splits, its
+    inner end (where the faces still go round) does not. A one-segment cut between
+    two vertices no other cut reaches cannot open: a free hinge (U)."""
+    xy = [(0, 0), (1, 0), (2, 0), (2, 1), (2, 2), (1, 2), (0, 2), (0, 1), (1, 1)]
+    border = [(i, (i + 1) % 8) for i in range(8)]
+    inner = [(8, 1), (8, 3), (8, 5), (8, 7)]
+    kinds = ["B"] * 8 + ["C", "V", "V", "V"]
+    with pytest.warns(PatternWarning, match="1 vertex copy"):
+        pattern = make(vertices=xy, edges=border + inner, assignments=kinds)
+    assert pattern.copied_from.tolist() == [1] and pattern.pieces == 1
+    assert pattern.assignments[8] == "B" and pattern.assignments[12] == "B"
+    shut = make(vertices=[(0, 0), (2, 0), (2, 2), (0, 2), (1, 0.5), (1, 1.5)],
+                edges=[(0, 1), (1, 2), (2, 3), (3, 0), (0, 4), (4, 1), (3, 5), (5, 2),
+                       (4, 5)],
+                assignments=["B"] * 4 + ["V"] * 4 + ["C"])
+    assert shut.n_vertices == 6 and shut.assignments[8] == "U"
+
+
+def test_vertices_drawn_twice_off_a_slit_are_refused_naming_one():
+    """Coincident vertices are the two sides of a slit only: two boundary edges on each
+    other. A vertex drawn twice elsewhere is refused, naming it."""
+    two = BOWTIE_V + [BOWTIE_V[0]]  # the bow-tie's second triangle on a vertex of its own
+    edges = [(0, 1), (1, 2), (2, 0), (5, 3), (3, 4), (4, 5)]
+    refused("vertex", 0, also=[5], vertices=two, edges=edges, assignments=["B"] * 6)
+    # the right square on copies of the crease's ends: the crease lies on a boundary edge
+    v = SQ_V + [SQ_V[4], SQ_V[5]]
+    e = [(0, 4), (6, 1), (1, 2), (2, 7), (5, 3), (3, 0), (4, 5), (6, 7)]
+    msg = refused("edges", 6, also=[7], vertices=v, edges=e, assignments=SQ_A + ["B"])
+    assert "only the two boundary sides of a slit may" in msg
 
 
 def test_wrong_number_of_assignments():
@@ -411,15 +472,26 @@ PINNED_A = ["B", "B", "B", "B", "V", "B", "B", "B", "B", "V"]
 
 
 @pytest.mark.parametrize("faces", [[[0, 1, 2], [0, 3, 4]], None], ids=["given", "derived"])
-def test_faces_meeting_only_at_a_vertex_are_refused_naming_it(faces):
-    msg = refused("vertex", 0, vertices=BOWTIE_V, edges=BOWTIE_E, assignments=["B"] * 6,
-                  faces=faces)
-    assert "bow-tie" in msg and "simulate each piece on its own" in msg
+def test_faces_meeting_only_at_a_vertex_are_refused_by_a_thick_sheet_naming_it(faces):
+    """A bow-tie is a pattern (a thin sheet folds it, as Origami Simulator does); a thick
+    sheet refuses it, naming the vertex."""
+    from foldcore import thicken
+
+    pattern = make(vertices=BOWTIE_V, edges=BOWTIE_E, assignments=["B"] * 6, faces=faces)
+    assert pattern.pinched.tolist() == [0]
+    with pytest.raises(PatternError) as info:
+        thicken(pattern, 1.0)
+    msg = str(info.value)
+    assert "vertex 0" in msg and "bow-tie" in msg and "simulate each piece on its own" in msg
 
 
-def test_creased_pieces_pinned_at_a_vertex_are_refused_naming_it():
-    msg = refused("vertex", 0, vertices=PINNED_V, edges=PINNED_E, assignments=PINNED_A)
-    assert "faces meet only at this vertex" in msg
+def test_creased_pieces_pinned_at_a_vertex_are_refused_by_a_thick_sheet_naming_it():
+    from foldcore import thicken
+
+    pattern = make(vertices=PINNED_V, edges=PINNED_E, assignments=PINNED_A)
+    assert pattern.pinched.tolist() == [0]
+    with pytest.raises(PatternError, match="vertex 0: faces meet only at this vertex"):
+        thicken(pattern, 1.0)
 
 
 def test_separate_pieces_are_a_pattern_that_a_thick_sheet_refuses_naming_a_vertex():

@@ -212,3 +212,43 @@ def test_a_degree2_vertex_between_two_assignments_stays():
     same = CreasePattern(xy, edges, ["B"] * 6 + ["V", "V"],
                          fold_angles=[np.nan] * 6 + [30.0, 30.0])
     assert build_sheet(same, merge_straight=True).merged.tolist() == [[6, 5, 2]]
+
+
+def test_a_cut_lets_two_flaps_fold_opposite_ways():
+    """A 100 mm square, its lower half cut in two flaps along x = 50 (a kirigami cut):
+    the left flap folds +90° (valley), the right −90° (mountain) about y = 50. Uncut,
+    the targets fight; cut, each flap turns alone, as rigid panels: both creases meet
+    their targets and the cut's lower end opens to 2 × 50 mm."""
+    import warnings
+
+    from foldcore.pattern import CreasePattern
+
+    xy = [(0, 0), (50, 0), (100, 0), (100, 50), (100, 100), (0, 100), (0, 50), (50, 50)]
+    border = [(0, 1), (1, 2), (2, 3), (3, 4), (4, 5), (5, 6), (6, 0)]
+    edges = border + [(6, 7), (7, 3), (1, 7)]
+    kinds = ["B"] * 7 + ["V", "M", "C"]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        pattern = CreasePattern(xy, edges, kinds, fold_angles=[None] * 7 + [90, -90, None])
+    assert pattern.copied_from.tolist() == [1]
+    fold = fold_sheet(build_sheet(pattern), 100.0, pattern_edges=pattern.n_edges)
+    assert fold.converged
+    assert np.allclose(fold.fold_angles_deg[[7, 8]], [90.0, -90.0], atol=EXACT_DEG)
+    ends = fold.positions[[1, 8]]  # the cut's lower end and its copy
+    assert abs(np.linalg.norm(ends[0] - ends[1]) - 100.0) < 1e-3
+
+
+def test_a_crease_ending_inside_a_face_folds_as_a_crease():
+    """A valley from the middle of a square's left side to its centre (a dangling crease,
+    as in Origami Simulator's curved and kirigami files): the face is cut into triangles
+    on both sides of it, so it is a hinge; folded to 20°, the facets beyond its tip bend
+    to let it, and the sheet settles with the crease folded the valley way."""
+    from foldcore.pattern import CreasePattern
+
+    xy = [(0, 0), (100, 0), (100, 100), (0, 100), (0, 50), (50, 50)]
+    edges = [(0, 1), (1, 2), (2, 3), (3, 4), (4, 0), (4, 5)]
+    pattern = CreasePattern(xy, edges, list("BBBBBV"), fold_angles=[None] * 5 + [20.0])
+    sheet = build_sheet(pattern)
+    assert (sheet.hinge_edge == 5).sum() == 1  # one hinge: triangles on both sides
+    fold = fold_sheet(sheet, 100.0, pattern_edges=pattern.n_edges)
+    assert fold.converged and 0.0 < fold.fold_angles_deg[5] < 20.0

@@ -142,16 +142,29 @@ def test_lines_drawn_over_each_other_read_as_origami_simulator_keeps_them(tmp_pa
     assert any("M over M" in m for m in said)
 
 
-@pytest.mark.parametrize("body, needles", [
-    ('<line x1="50" y1="0" x2="50" y2="100" stroke="#0f0"/>', ["line", "cut"]),
-])
-def test_what_foldcore_cannot_fold_is_refused_naming_the_element(tmp_path, body, needles):
-    with pytest.raises(PatternError) as info:
-        read_text(tmp_path, svg(SQUARE + body))
-    message = str(info.value)
-    assert "p.svg" in message and "\n" not in message
-    for needle in needles:
-        assert needle in message, message
+def test_a_green_line_is_a_cut_that_splits_the_sheet_said_once(tmp_path):
+    """Origami Simulator's green line cuts the sheet: across the square, two pieces."""
+    pattern, said = read_text(tmp_path, svg(SQUARE + '<line x1="50" y1="0" x2="50" '
+                                            'y2="100" stroke="#0f0"/>'))
+    assert pattern.pieces == 2 and set(pattern.assignments) == {"B"}
+    assert len(pattern.copied_from) == 2
+    assert [m for m in said if "cut edge" in m] == [
+        f"{tmp_path / 'p.svg'}: 1 cut edge ('C'): the sheet is split along it, each side a "
+        "boundary edge (2 vertex copies along the cuts)"]
+
+
+def test_lines_drawn_outside_the_sheet_are_left_out_said_once(tmp_path):
+    """A crease and a boundary stub sticking out of the square, and a crease ending
+    inside it: the stubs outside fold nothing and are left out; the inner crease stays
+    (a dangling crease)."""
+    body = SQUARE + ('<line x1="100" y1="50" x2="130" y2="50" stroke="#f00"/>'
+                     '<line x1="0" y1="20" x2="-20" y2="20" stroke="#000"/>'
+                     '<line x1="0" y1="50" x2="50" y2="50" stroke="#00f"/>')
+    pattern, said = read_text(tmp_path, svg(body, size=140))
+    grid = 1.5 * MM_PER_PX  # the snap distance of a 150 px drawing (1 % of it)
+    assert np.ptp(pattern.vertices[:, 0]) == pytest.approx(100 * MM_PER_PX, abs=grid)
+    assert crease_set(pattern) == {("V", 180.0): 1} and len(pattern.dangling) == 1
+    assert len([m for m in said if "sheet on neither side" in m and "2 lines" in m]) == 1
 
 
 def test_a_straight_bezier_is_a_line_and_other_colours_are_ignored_said_once(tmp_path):

@@ -21,8 +21,11 @@ from .planar import (
     signed_areas,
 )
 
-#: Assignments foldcore simulates. ``C`` (cut) and ``J`` (join) are refused.
+#: Assignments foldcore simulates. ``C`` (cut) is read and split (:mod:`foldcore.cuts`);
+#: ``J`` (join) is refused.
 ASSIGNMENTS = ("M", "V", "B", "F", "U")
+#: Assignments a pattern is given with.
+GIVEN_ASSIGNMENTS = ASSIGNMENTS + ("C",)
 DEFAULT_MAX_ANGLE_DEG = 180.0
 #: Largest coordinate magnitude, mm; beyond it squared lengths and areas overflow.
 MAX_COORDINATE_MM = 1e100
@@ -42,7 +45,10 @@ class CreasePattern:
         Vertex ids of each edge.
     assignments : (E,) sequence of str
         ``M`` mountain, ``V`` valley, ``B`` boundary, ``F`` flat (held at 0°),
-        ``U`` unassigned (passive, either direction).
+        ``U`` unassigned (passive, either direction), ``C`` cut: the sheet is
+        split along it (:mod:`foldcore.cuts`; a :class:`PatternWarning` says
+        so), so the pattern then has more vertices and edges than given, and
+        no ``C``.
     fold_angles : (E,) array_like of float or None, optional
         Target fold angle per edge in degrees, valley positive. ``None``/NaN
         means passive (the crease folds as the mechanism dictates). Default:
@@ -87,9 +93,13 @@ class CreasePattern:
         else:
             loops = loops_of(faces)
             flat, lengths = self._counter_clockwise(loops.flat, loops.lengths)
-        self._loops = Loops(_frozen(flat), _frozen(lengths))
         self._faces = None
         self.edge_faces = _frozen(self._match_faces(flat, lengths))
+        #: (V' − V,) int: the given vertex each copy made along a cut came from
+        self.copied_from = np.zeros(0, dtype=np.int64)
+        if (self.assignments == "C").any():
+            flat = self._split_cuts(flat, lengths)
+        self._loops = Loops(_frozen(flat), _frozen(lengths))
 
     # ----------------------------------------------------------------- queries
     @property
@@ -146,6 +156,26 @@ class CreasePattern:
         return (f"CreasePattern({self.source!r}: {self.n_vertices} vertices, "
                 f"{self.n_edges} edges [{summary}], {len(self._loops)} faces)")
 
+    def _split_cuts(self, flat: np.ndarray, lengths: np.ndarray) -> np.ndarray:
+        """Split the pattern along its ``C`` edges (:mod:`foldcore.cuts`), said in a
+        warning; the renumbered face loops (``flat``, ``lengths``) in return."""
+        from .cuts import cut_note, split_along_cuts
+
+        cut = self.assignments == "C"
+        split = split_along_cuts(self.vertices, self.edges, flat, lengths, self.edge_faces, cut)
+        twice = np.concatenate([np.arange(self.n_edges), split.second_side_of])
+        assignments = np.where(cut, np.where(split.shut, "U", "B"), self.assignments)[twice]
+        fold_angles = np.where(cut, np.nan, self.fold_angles)[twice]
+        self.vertices, self.edges = _frozen(split.vertices), _frozen(split.edges)
+        self.assignments, self.fold_angles = _frozen(assignments), _frozen(fold_angles)
+        self.widths = _frozen(np.where(cut, np.nan, self.widths)[twice])
+        self.max_angles = _frozen(self.max_angles[twice])
+        self.copied_from = _frozen(split.copied_from)
+        self._validate_connected()
+        self.edge_faces = _frozen(self._match_faces(split.flat, lengths))
+        warnings.warn(f"{self.source}: {cut_note(split)}", PatternWarning, stacklevel=4)
+        return split.flat
+
     # -------------------------------------------------------------- validation
     def _fail(self, message: str):
         raise PatternError(f"{self.source}: {message}")
@@ -164,13 +194,60 @@ class CreasePattern:
         degree = np.bincount(self.edges.ravel(), minlength=self.n_vertices)
         for v in np.flatnonzero(degree == 0):
             self._fail(f"vertex {v} is not on any edge")
-        for v in np.flatnonzero(degree == 1):
-            e = int(np.flatnonzero((self.edges == v).any(axis=1))[0])
-            self._fail(f"edge {e} is dangling (vertex {v} has no other edge)")
+        self._validate_dangling(np.flatnonzero(degree == 1))
         del lengths, key, first, counts, degree  # not held through the crossing test
         self._validate_connected()
-        for i, j in crossing_pairs(self.vertices, self.edges):
-            self._fail(f"edges {i} and {j} cross or overlap")
+        self._validate_crossings()
+
+    def _validate_dangling(self, ends: np.ndarray):
+        """Record the creases that end inside a face (``ends``: the vertices of degree
+        1) as :attr:`dangling`; refuse a dangling boundary or cut edge."""
+        on_end = np.flatnonzero(np.isin(self.edges, ends).any(axis=1))
+        for e in on_end[np.isin(self.assignments[on_end], ("B", "C"))][:1]:
+            v = int(np.intersect1d(self.edges[e], ends)[0])
+            self._fail(f"edge {e} is dangling (vertex {v} has no other edge) and is assigned "
+                       f"{str(self.assignments[e])!r}: only a crease may end inside a face")
+        #: (D,) int: the creases with an end inside a face (a vertex on no other edge)
+        self.dangling = _frozen(on_end)
+
+    def check_no_dangling(self, what: str = "a thick sheet") -> None:
+        """PatternError naming the first crease that ends inside a face (a thin sheet
+        folds them, as Origami Simulator does; a thick one has no panel to end in)."""
+        if len(self.dangling):
+            e = int(self.dangling[0])
+            self._fail(f"edge {e} is a crease that ends inside a face (dangling); {what} "
+                       "needs every crease to run from edge to edge: extend it, remove it, "
+                       "or fold the pattern as a thin sheet (no thickness)")
+
+    def _validate_crossings(self):
+        """Refuse edges that cross or overlap. Vertices at one point are one there (the
+        two sides of a slit, :mod:`foldcore.cuts`): their edges may meet at it, and two
+        boundary edges may lie on each other; any other coincidence is refused."""
+        from .cuts import welded_ids
+
+        weld = welded_ids(self.vertices)
+        if weld is None:
+            for i, j in crossing_pairs(self.vertices, self.edges):
+                self._fail(f"edges {i} and {j} cross or overlap")
+            return
+        ends = np.sort(weld[self.edges], axis=1)
+        _, first, inverse = np.unique(ends, axis=0, return_index=True, return_inverse=True)
+        inverse = inverse.ravel()
+        twins = np.flatnonzero(first[inverse] != np.arange(self.n_edges))
+        for j in twins:
+            i = int(first[inverse[j]])
+            if self.assignments[i] != "B" or self.assignments[j] != "B":
+                self._fail(f"edges {i} and {j} lie on each other (their ends are at the "
+                           "same points); only the two boundary sides of a slit may")
+        slit_ends = np.zeros(self.n_vertices, dtype=bool)
+        slit_ends[self.edges[np.concatenate([twins, first[inverse[twins]]])]] = True
+        shared = np.bincount(weld, minlength=self.n_vertices)[weld] > 1
+        for v in np.flatnonzero(shared & ~slit_ends)[:1]:
+            other = int(np.flatnonzero((weld == weld[v]) & (np.arange(self.n_vertices) != v))[0])
+            self._fail(f"vertex {v} is at the same point as vertex {other} but not on a slit "
+                       "(two boundary edges on each other): join them into one vertex")
+        for i, j in crossing_pairs(self.vertices, ends[first]):
+            self._fail(f"edges {int(first[i])} and {int(first[j])} cross or overlap")
 
     def _validate_connected(self):
         """Count the separate pieces (:attr:`pieces`); a thick sheet needs one
@@ -184,7 +261,13 @@ class CreasePattern:
         self.pieces, self._piece_of = connected_components(graph, directed=False)
 
     def check_one_piece(self, what: str = "a thick sheet") -> None:
-        """PatternError naming a vertex of a second piece when the pattern is several."""
+        """PatternError naming a vertex of a second piece when the pattern is several,
+        or a vertex where faces meet at the vertex alone (:attr:`pinched`)."""
+        for v in self.pinched[:1]:
+            self._fail(f"vertex {v}: faces meet only at this vertex (a bow-tie); {what} "
+                       "must hang together along its edges: simulate each piece on its own, "
+                       "join the faces along an edge, or fold it as a thin sheet (no "
+                       "thickness)")
         if self.pieces > 1:
             v = int(np.flatnonzero(self._piece_of != self._piece_of[0])[0])
             e = int(np.flatnonzero((self.edges == v).any(axis=1))[0])
@@ -198,7 +281,7 @@ class CreasePattern:
         with np.errstate(invalid="ignore"):
             bad = ~np.isnan(angle) & ((np.abs(angle) > 180.0) | (kind == "M") & (angle > 0)
                                       | (kind == "V") & (angle < 0)
-                                      | ((kind == "B") | (kind == "F")) & (angle != 0))
+                                      | np.isin(kind, ("B", "F", "C")) & (angle != 0))
         for e in np.flatnonzero(bad)[:1]:  # the first edge in error, its first error
             self._check_angle(e, kind[e], angle[e])
         bad_w = ~np.isnan(self.widths) & ~(self.widths > 0)
@@ -220,7 +303,7 @@ class CreasePattern:
             if kind == "M" and angle > 0 or kind == "V" and angle < 0:
                 self._fail(f"edge {e}: fold angle {angle:g}° contradicts assignment "
                            f"{str(kind)!r} (valley > 0, mountain < 0)")
-            if kind in "BF" and angle != 0:
+            if kind in "BFC" and angle != 0:
                 self._fail(f"edge {e}: fold angle {angle:g}° on a {str(kind)!r} edge "
                            "(must be 0 or passive)")
 
@@ -292,8 +375,10 @@ class CreasePattern:
         return edge_faces
 
     def _validate_fans(self, flat: np.ndarray, inner: np.ndarray):
-        """Refuse a vertex where the sheet is pinched: its faces (``flat``: every face
-        corner's vertex) form more than one fan, joined at the vertex alone (a bow-tie).
+        """Record as :attr:`pinched` the vertices where the sheet is pinched: their faces
+        (``flat``: every face corner's vertex) form more than one fan, joined at the
+        vertex alone (a bow-tie). A thin sheet folds them, as Origami Simulator does;
+        a thick one refuses them (:meth:`check_one_piece`).
 
         The faces about a vertex, linked across its edges with a face on each side
         (``inner``), are a path (on the boundary: one face more than such edges) or a
@@ -302,10 +387,8 @@ class CreasePattern:
         n = self.n_vertices
         corners = np.bincount(flat, minlength=n)
         links = np.bincount(self.edges[inner].ravel(), minlength=n)
-        for v in np.flatnonzero(corners - links > 1)[:1]:
-            self._fail(f"vertex {v}: faces meet only at this vertex (a bow-tie); a sheet "
-                       "must hang together along its edges: simulate each piece on its own, "
-                       "or join the faces along an edge")
+        #: (P,) int: vertices where faces meet at the vertex alone (bow-ties)
+        self.pinched = _frozen(np.flatnonzero(corners - links > 1))
 
 
 def _reversed_loops(flat, starts, lengths, flip) -> np.ndarray:
@@ -391,13 +474,12 @@ def _as_assignments(assignments, n_edges: int, source: str) -> np.ndarray:
     if len(a) != n_edges:
         raise PatternError(f"{source}: {len(a)} assignments for {n_edges} edges")
     for e, kind in enumerate(a):
-        if kind in ("C", "J"):
-            raise PatternError(f"{source}: edge {e} has assignment {kind!r} "
-                               "(cut/join edges are not supported; split or merge the "
-                               "faces in the pattern instead)")
-        if kind not in ASSIGNMENTS:
+        if kind == "J":
+            raise PatternError(f"{source}: edge {e} has assignment 'J' (join edges are not "
+                               "supported; merge the faces in the pattern instead)")
+        if kind not in GIVEN_ASSIGNMENTS:
             raise PatternError(f"{source}: edge {e} has unknown assignment {kind!r} "
-                               f"(expected one of {', '.join(ASSIGNMENTS)})")
+                               f"(expected one of {', '.join(GIVEN_ASSIGNMENTS)})")
     return np.array(a, dtype="<U1")
 
 
@@ -405,9 +487,9 @@ def _all_known(assignments) -> bool:
     """True for a 1-D str array or a list/tuple of str, every one in ASSIGNMENTS."""
     if isinstance(assignments, np.ndarray):
         return assignments.ndim == 1 and assignments.dtype.kind == "U" \
-            and bool(np.isin(assignments, ASSIGNMENTS).all())
+            and bool(np.isin(assignments, GIVEN_ASSIGNMENTS).all())
     return isinstance(assignments, (list, tuple)) and set(map(type, assignments)) <= {str} \
-        and set(assignments) <= set(ASSIGNMENTS)
+        and set(assignments) <= set(GIVEN_ASSIGNMENTS)
 
 
 def _per_edge(values, n_edges: int, default: float, name: str, source: str) -> np.ndarray:

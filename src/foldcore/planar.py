@@ -321,8 +321,6 @@ def derive_face_loops(vertices: np.ndarray, edges: np.ndarray, boundary: np.ndar
     """:func:`derive_faces` as (N,) concatenated vertex ids and (F,) loop lengths."""
     corners, halfedges, lengths = face_cycles(vertices, edges)
     areas = signed_areas(vertices, corners, lengths)
-    if np.count_nonzero(areas < 0) > 1:
-        _check_pieces_apart(vertices, corners, lengths, areas, source)
     edge_of = halfedges % max(len(edges), 1)
     cycle_of = np.repeat(np.arange(len(lengths)), lengths)
     outer = np.zeros(len(edges), dtype=bool)
@@ -331,21 +329,27 @@ def derive_face_loops(vertices: np.ndarray, edges: np.ndarray, boundary: np.ndar
     not_hole_side = ~boundary[edge_of] | outer[edge_of]
     is_hole = np.bincount(cycle_of, weights=not_hole_side, minlength=len(lengths)) == 0
     keep = (areas > 0) & ~is_hole
-    return corners[keep[cycle_of]], lengths[keep]
+    flat, kept = corners[keep[cycle_of]], lengths[keep]
+    if np.count_nonzero(areas < 0) > 1:
+        _check_pieces_apart(vertices, flat, kept, source)
+    return flat, kept
 
 
-def _check_pieces_apart(vertices, corners, lengths, areas, source: str) -> None:
-    """PatternError naming a vertex of a piece that lies inside another piece's
-    outline (sheets drawn over each other), for a pattern of several pieces."""
-    from shapely import Polygon, points, contains
+def _check_pieces_apart(vertices, flat, lengths, source: str) -> None:
+    """PatternError naming a vertex that lies inside a face (``flat``, ``lengths``: the
+    faces' loops) of another piece (sheets drawn over each other), for a pattern of
+    several pieces; a piece inside another's hole is apart from it."""
+    import shapely
 
-    outlines = [loop for loop, a in zip(split_loops(corners, lengths), areas) if a < 0]
-    for i, outline in enumerate(outlines):
-        others = np.setdiff1d(np.concatenate(outlines[:i] + outlines[i + 1:]), outline)
-        inside = others[contains(Polygon(vertices[outline]), points(vertices[others]))]
-        if len(inside):
-            raise PatternError(f"{source}: vertex {int(inside[0])} lies inside another piece "
-                               "(pieces drawn over each other, or an unjoined hole)")
+    rings = shapely.linearrings(vertices[flat], indices=np.repeat(np.arange(len(lengths)),
+                                                                    lengths))
+    faces = shapely.polygons(rings)
+    tree = shapely.STRtree(faces)
+    inside, face = tree.query(shapely.points(vertices), predicate="within")
+    if len(inside):
+        k = int(np.argmin(inside))
+        raise PatternError(f"{source}: vertex {int(inside[k])} lies inside another piece, "
+                           f"in its face {int(face[k])} (pieces drawn over each other)")
 
 
 def crossing_pairs(vertices: np.ndarray, edges: np.ndarray) -> list[tuple[int, int]]:

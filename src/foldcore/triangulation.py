@@ -112,6 +112,82 @@ def _not_simple(face, xy: np.ndarray, tris, covered: float) -> str:
             f"not simple ({len(tris)} triangle(s) covering {covered:.6g} mm²{detail})")
 
 
+def slit_free_loops(xy: np.ndarray, loop: np.ndarray) -> list:
+    """A face's loop cut into loops without slits, each a simple polygon for earcut.
+
+    Where a crease ends inside a face, the face's loop runs out along it to its
+    tip and back (``…, b, t, b, …``), which ear clipping does not take. Each
+    tip is joined by a straight segment to the nearest vertex of the loop it
+    sees (met once in the loop; the segment crosses no side and runs inside
+    the face): the loop is cut in two along it, each running along the slit
+    once. The segments are new diagonals of the face.
+
+    Parameters
+    ----------
+    xy : (V, 2) float, mm (any frame), indexed by the loop's ids
+    loop : (n,) int, counter-clockwise
+
+    Returns
+    -------
+    list of (n_i,) int loops, counter-clockwise; ``[loop]`` when it has no slit.
+    """
+    pending, done = [np.asarray(loop)], []
+    while pending:
+        here = pending.pop()
+        tips = np.flatnonzero(np.roll(here, 1) == np.roll(here, -1))
+        if not len(tips) or len(here) < 4:
+            done.append(here)
+            continue
+        i = int(tips[0])
+        j = _seen_from(xy, here, i)
+        if j is None:
+            done.append(here)  # earcut's check then names the face
+            continue
+        lo, hi = min(i, j), max(i, j)
+        pending += [here[lo:hi + 1], np.concatenate([here[hi:], here[:lo + 1]])]
+    return done
+
+
+def _seen_from(xy: np.ndarray, loop: np.ndarray, i: int):
+    """Position in ``loop`` of the nearest vertex met once in it that the tip at
+    position ``i`` sees inside the face, or None."""
+    ids, counts = np.unique(loop, return_counts=True)
+    once = np.isin(loop, ids[counts == 1])
+    once[[(i - 1) % len(loop), i, (i + 1) % len(loop)]] = False
+    tip = xy[loop[i]]
+    a, b = xy[loop], xy[np.roll(loop, -1)]
+    for k in np.flatnonzero(once)[np.argsort(np.linalg.norm(xy[loop[once]] - tip, axis=1))]:
+        w = xy[loop[k]]
+        apart = (loop != loop[i]) & (loop != loop[k]) & (np.roll(loop, -1) != loop[i]) \
+            & (np.roll(loop, -1) != loop[k])
+        if not segments_meet(tip, w, a[apart], b[apart]).any() \
+                and _inside(0.5 * (tip + w), xy[loop]):
+            return int(k)
+    return None
+
+
+def segments_meet(p, q, a, b) -> np.ndarray:
+    """(m,) bool: segment p–q (2,) meets segment a[k]–b[k] ((m, 2) each; touching
+    counts)."""
+    def orient(u, v, w):
+        return np.sign((v[..., 0] - u[..., 0]) * (w[..., 1] - u[..., 1])
+                       - (v[..., 1] - u[..., 1]) * (w[..., 0] - u[..., 0]))
+
+    o1, o2 = orient(p, q, a), orient(p, q, b)
+    o3, o4 = orient(a, b, p), orient(a, b, q)
+    return (o1 * o2 <= 0) & (o3 * o4 <= 0)
+
+
+def _inside(point, ring: np.ndarray) -> bool:
+    """Whether ``point`` lies inside the closed ``ring`` (n, 2) (even–odd rule)."""
+    x, y = point
+    a, b = ring, np.roll(ring, -1, axis=0)
+    spans = (a[:, 1] > y) != (b[:, 1] > y)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        cross_x = a[:, 0] + (y - a[:, 1]) * (b[:, 0] - a[:, 0]) / (b[:, 1] - a[:, 1])
+    return bool(np.count_nonzero(spans & (cross_x > x)) % 2)
+
+
 def _shoelace(xy: np.ndarray) -> float:
     """Signed area of a polygon (n, 2), counter-clockwise > 0."""
     x, y = xy[:, 0], xy[:, 1]

@@ -34,6 +34,8 @@ PARALLEL = 0.1
 #: its SVG reader lists first (it reads borders, then mountains, valleys, facet
 #: lines, hinges and cuts, and drops the later of two equal edges).
 OVERLAP_ORDER = ("B", "M", "V", "F", "U", "C")
+#: Times the merged drawing is noded again where a merge moved a vertex across an edge.
+RENODING_PASSES = 3
 
 
 def pattern_from_lines(segments: np.ndarray, kinds, angles, owners, source: str, *,
@@ -73,18 +75,20 @@ def pattern_from_lines(segments: np.ndarray, kinds, angles, owners, source: str,
                      f"({' '.join(OVERLAP_ORDER)}, then file order): "
                      + ", ".join(f"{k} over {v}" for (k, v) in sorted(overlaps)))
     if sides_as_origami_simulator:
-        assignments, fold_angles = sides_read_as_origami_simulator(
+        vertices, edges, assignments, fold_angles = sides_read_as_origami_simulator(
             vertices, edges, assignments, fold_angles, source)
     return CreasePattern(vertices * factor, edges, assignments, fold_angles=fold_angles,
                          source=source)
 
 
 def sides_read_as_origami_simulator(vertices, edges, assignments, fold_angles, source: str):
-    """(assignments, fold_angles) with the lines whose type contradicts their sides read
-    as Origami Simulator reads them, each kind said once with a count: a crease (M, V,
-    F, U) with the sheet on one side only is boundary (B: no face to fold against),
-    a boundary line (B) with the sheet on both sides is a free hinge (U: a bar
-    without a spring)."""
+    """(vertices, edges, assignments, fold_angles) with the lines whose type contradicts
+    their sides read as Origami Simulator reads them, each kind said once with a
+    count: a crease (M, V, F, U) with the sheet on one side only is boundary (B: no
+    face to fold against), a boundary line (B) with the sheet on both sides is a free
+    hinge (U: a bar without a spring). Lines with the sheet on neither side (drawn
+    outside it, or in a hole) fold nothing and are left out, with the vertices only
+    they reach."""
     from ..planar import derive_face_loops, loop_starts, next_in_loop
 
     assignments = np.array(assignments, dtype="<U1")
@@ -99,6 +103,11 @@ def sides_read_as_origami_simulator(vertices, edges, assignments, fold_angles, s
                            minlength=len(edges))
     lone = np.flatnonzero((per_edge == 1) & (assignments != "B"))
     inner = np.flatnonzero((per_edge == 2) & (assignments == "B"))
+    outside = per_edge == 0
+    if outside.any():
+        note(source, f"{int(outside.sum())} lines with the sheet on neither side (edge "
+                     f"{int(np.argmax(outside))}, …) left out: drawn outside the sheet, they "
+                     "fold nothing")
     if len(lone):
         note(source, f"{len(lone)} creases with the sheet on one side only (edge "
                      f"{int(lone[0])}, …) read as boundary, as Origami Simulator reads them")
@@ -108,7 +117,11 @@ def sides_read_as_origami_simulator(vertices, edges, assignments, fold_angles, s
                      f"{int(inner[0])}, …) read as free hinges (U), as Origami Simulator "
                      "folds them")
         assignments[inner], fold_angles[inner] = "U", np.nan
-    return assignments, fold_angles
+    if not outside.any():
+        return vertices, edges, assignments, fold_angles
+    used, ends = np.unique(edges[~outside], return_inverse=True)
+    return (vertices[used], ends.reshape(-1, 2), assignments[~outside],
+            fold_angles[~outside])
 
 
 def check_meetings(segments: np.ndarray, source: str) -> None:
@@ -137,7 +150,23 @@ def planarise(segments: np.ndarray, tol: float, source: str = "<segments>"):
     overlaps noded (shapely's unary union)."""
     import shapely
 
+    from ..planar import crossing_pairs
+
     segments = _snap_endpoints(segments, tol)
+    vertices, edges, pieces = _node_and_merge(segments, tol, source)
+    for _ in range(RENODING_PASSES):  # a merge moved a vertex across an edge: node again
+        if not crossing_pairs(vertices, edges):
+            break
+        vertices, edges, pieces = _node_and_merge(vertices[edges], tol, source)
+    vertices, edges = in_drawing_order(vertices, edges, segments, tol)
+    return vertices, edges, pieces
+
+
+def _node_and_merge(segments: np.ndarray, tol: float, source: str):
+    """(vertices, edges, pieces) of :func:`planarise`: the segments noded (shapely's
+    unary union), points within ``tol`` merged, pieces merged to nothing dropped."""
+    import shapely
+
     lines = shapely.linestrings(segments)
     noded = shapely.unary_union(shapely.set_precision(lines, tol))
     pieces = []
@@ -150,8 +179,7 @@ def planarise(segments: np.ndarray, tol: float, source: str = "<segments>"):
     keep = edges[:, 0] != edges[:, 1]  # a piece shorter than tol: its ends merged
     edges, first = np.unique(edges[keep], axis=0, return_index=True)
     used, edges = np.unique(edges, return_inverse=True)
-    vertices, edges = in_drawing_order(vertices[used], edges.reshape(-1, 2), segments, tol)
-    return vertices, edges, pieces[keep][first]
+    return vertices[used], edges.reshape(-1, 2), pieces[keep][first]
 
 
 def in_drawing_order(vertices: np.ndarray, edges: np.ndarray, segments: np.ndarray,

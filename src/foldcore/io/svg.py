@@ -13,7 +13,7 @@ blue ``#0000ff``        valley      ``V``, target +opacity × 180°
 black ``#000000``       boundary    ``B``
 yellow ``#ffff00``      facet       ``F`` (held flat, 0°)
 magenta ``#ff00ff``     undriven    ``U`` (passive hinge)
-green ``#00ff00``       cut         refused: foldcore does not cut sheets
+green ``#00ff00``       cut         ``C``: the sheet is split along it
 ======================  ==========  ===================================
 
 Colours are matched as Origami Simulator matches them (``#f00``, ``red``,
@@ -95,7 +95,7 @@ def read_svg(path, reading: Reading | None = None) -> CreasePattern:
     Raises
     ------
     PatternError
-        Not an SVG, no creases, a cut, conflicting types on one segment, or a
+        Not an SVG, no creases, conflicting types on one segment, or a
         malformed pattern (named as :class:`CreasePattern` names it).
     """
     source = os.fspath(path)
@@ -127,10 +127,6 @@ def _strokes(source: str):
                 else element.stroke.hex
             ignored[colour] = ignored.get(colour, 0) + 1
             continue
-        if kind == "C":
-            raise PatternError(f"{source}: {name} is a cut (green stroke); foldcore does "
-                               "not cut sheets: draw the cut as boundary (black) around "
-                               "separate pieces, or remove it")
         angle = sign * 180.0 * _opacity(element, name, source) if sign \
             else (0.0 if kind == "F" else np.nan)
         try:

@@ -5,7 +5,10 @@ so for SVG files, not for FOLD files), a vertex of degree 2 whose two edges
 run within about 8° of straight on (|cos + 1| < ``STRAIGHT``) and share their
 assignment is left out, its two edges merged into one (its
 ``removeRedundantVertices``: vertex by vertex, in id order, each merge seen by
-the next); the merged edge's target is the mean of its edges' non-zero ones. In
+the next); the merged edge's target is the mean of its edges' non-zero ones. A vertex
+whose merged edge would meet another line stays (on a curve drawn as a fine
+polyline, a long chord can cut across a nearby crease's end: the face would
+fold over itself; Origami Simulator merges it all the same). In
 the folded sheet such a vertex lies on its merged edge where it lay in the flat
 one (the same share of its length).
 
@@ -26,7 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..pattern import CreasePattern
-from ..triangulation import triangulate_polygon
+from ..triangulation import segments_meet, slit_free_loops, triangulate_polygon
 
 BAR, HINGE, TRIANGLE = 0, 1, 2
 TIE = 1e-9  # diagonals of a quadrilateral this close (relative, squared) are equal
@@ -121,7 +124,8 @@ class Sheet:
 
 
 def face_triangles(xy: np.ndarray, loop: np.ndarray, face: int) -> np.ndarray:
-    """(n − 2, 3) vertex ids of face ``loop`` cut as Origami Simulator cuts it."""
+    """(T, 3) vertex ids of face ``loop`` cut as Origami Simulator cuts it (n − 2
+    triangles; a loop along a slit first cut in two, :func:`slit_free_loops`)."""
     if len(loop) == 3:
         return loop[None, :].copy()
     if len(loop) == 4:
@@ -134,7 +138,8 @@ def face_triangles(xy: np.ndarray, loop: np.ndarray, face: int) -> np.ndarray:
         if use_13:
             return loop[np.array([[0, 1, 3], [1, 2, 3]])]
         return loop[np.array([[0, 1, 2], [0, 2, 3]])]
-    return loop[triangulate_polygon(xy[loop], face)]
+    return np.concatenate([part[triangulate_polygon(xy[part], face)]
+                           for part in slit_free_loops(xy, loop)])
 
 
 def _hinges(triangles: np.ndarray):
@@ -207,7 +212,8 @@ def merge_straight_vertices(pattern: CreasePattern, limit: float = STRAIGHT) -> 
     """The :class:`Merging` of ``pattern``'s straight degree-2 vertices, Origami
     Simulator's rule: vertex by vertex in id order, a vertex with two neighbours
     (as earlier merges left them) whose edges' |cos + 1| is below ``limit`` (0:
-    none), that share their assignment and whose neighbours are not joined."""
+    none), that share their assignment and whose neighbours are not joined, unless
+    the merged edge would meet another edge."""
     xy = np.asarray(pattern.vertices, dtype=float)
     kinds = np.asarray(pattern.assignments)
     angles = np.asarray(pattern.fold_angles, dtype=float).copy()
@@ -217,6 +223,8 @@ def merge_straight_vertices(pattern: CreasePattern, limit: float = STRAIGHT) -> 
         neighbours[a][int(b)] = e
         neighbours[b][int(a)] = e
     alias = np.arange(pattern.n_edges)
+    ends = np.array(pattern.edges)  # each live edge's ends as merges leave them
+    live = np.ones(pattern.n_edges, dtype=bool)
     merged, merged_at = [], []
     for v in range(len(xy)):
         if len(neighbours[v]) != 2:
@@ -224,8 +232,10 @@ def merge_straight_vertices(pattern: CreasePattern, limit: float = STRAIGHT) -> 
         (a, ea), (b, eb) = neighbours[v].items()
         u, w = xy[a] - xy[v], xy[b] - xy[v]
         cosine = float(u @ w) / max(float(np.sqrt((u @ u) * (w @ w))), 1e-300)
-        if not abs(cosine + 1.0) < limit or kinds[ea] != kinds[eb] or b in neighbours[a]:
+        if not abs(cosine + 1.0) < limit or kinds[ea] != kinds[eb] or b in neighbours[a] \
+                or _chord_meets(xy, ends, live, a, b):
             continue
+        ends[ea], live[eb] = (a, b), False
         both = [x for x in (angles[ea], angles[eb]) if x and not np.isnan(x)]
         angles[ea] = np.mean(both) if both else angles[ea]
         alias[alias == eb] = ea
@@ -240,6 +250,13 @@ def merge_straight_vertices(pattern: CreasePattern, limit: float = STRAIGHT) -> 
             edges[(min(a, b), max(a, b))] = e
     return Merging(np.array(merged, dtype=np.int64).reshape(-1, 3), np.array(merged_at),
                    alias, edges, angles)
+
+
+def _chord_meets(xy, ends, live, a: int, b: int) -> bool:
+    """Whether the straight chord a–b meets a live edge (``ends``, ``live``) that does not
+    end at a or b: merging the vertex between them would fold a face over itself."""
+    other = live & (ends[:, 0] != a) & (ends[:, 1] != a) & (ends[:, 0] != b) & (ends[:, 1] != b)
+    return bool(segments_meet(xy[a], xy[b], xy[ends[other, 0]], xy[ends[other, 1]]).any())
 
 
 def build_sheet(pattern: CreasePattern, stiffness: Stiffness = Stiffness(),

@@ -104,6 +104,7 @@ def _resolve(pattern, thickness, hinge_width, subdivisions, bend_radius, hinge, 
              stretch) -> _Sheet:
     """Check ``thicken``'s arguments and resolve widths, hinge models and sub-strips."""
     pattern.check_one_piece()
+    pattern.check_no_dangling()
     check_thickness(pattern, thickness)
     check_stiffness(pattern, stiffness)
     widths = resolve_widths(pattern, thickness, hinge_width, bend_radius)
