@@ -86,11 +86,34 @@ def match(pattern, state: dict):
 
     theirs = normalised(state["fold"]["vertices_coords"][:, [0, 2]] * [1.0, -1.0])
     vertices = np.asarray(pattern.vertices, dtype=float)
-    kept = build_sheet(pattern, merge_straight=True).vertex_ids
-    gap, idx = cKDTree(theirs).query(normalised(vertices)[kept])
-    gap = float(gap.max())
+    sheet = build_sheet(pattern, merge_straight=True)
+    kept = sheet.vertex_ids
+    mine = normalised(vertices)[kept]
+    k = min(4, len(theirs))
+    gaps, near = cKDTree(theirs).query(mine, k=k)
+    gaps, near = gaps.reshape(len(mine), k), near.reshape(len(mine), k)
+    # vertices at one point (the two sides of a cut): the one whose faces lie the same way
+    fans = fan_directions(mine, sheet.triangles) @ fan_directions(theirs, state["faces"]).T \
+        if k > 1 and (gaps[:, 1] - gaps[:, 0] < 1e-9).any() else None
+    idx = near[:, 0].copy()
+    for i in np.flatnonzero(gaps[:, 1] - gaps[:, 0] < 1e-9) if fans is not None else []:
+        tied = near[i][gaps[i] - gaps[i, 0] < 1e-9]
+        idx[i] = tied[np.argmax(fans[i, tied])]
+    gap = float(gaps[:, 0].max())
     one_to_one = len(idx) == len(theirs) and len(np.unique(idx)) == len(idx)
     return ((kept, idx) if gap <= MATCH and one_to_one else None), gap
+
+
+def fan_directions(points: np.ndarray, triangles) -> np.ndarray:
+    """(N, 2) unit vector from each point towards the mean centroid of its triangles."""
+    triangles = np.asarray(triangles, dtype=np.int64)
+    centroid = points[triangles].mean(axis=1)
+    total, count = np.zeros_like(points), np.zeros(len(points))
+    for corner in range(3):
+        np.add.at(total, triangles[:, corner], centroid)
+        np.add.at(count, triangles[:, corner], 1.0)
+    d = total / np.maximum(count, 1.0)[:, None] - points
+    return d / np.maximum(np.linalg.norm(d, axis=1), 1e-300)[:, None]
 
 
 def fold(pattern, percent: float, runs: int, drawing: bool = False):

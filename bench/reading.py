@@ -69,7 +69,7 @@ BEFORE_ONLY_ABOVE = 10**6
 BEFORE_BIG = {("fold", "valid"), ("fold", "cross")}
 CHILD_TIMEOUT_S = 1800
 #: kinds of SVG refusal, by a phrase of the message
-KINDS = (("curved", "curved"), ("cut", "is a cut"), ("overlap", "overlap with different"),
+KINDS = (("curved", "curved"), ("overlap", "overlap with different"),
          ("not connected", "not connected"), ("boundary/faces", "boundary"),
          ("boundary/faces", "both sides"), ("dangling", "dangling"),
          ("not an SVG", "not a readable SVG"))

@@ -171,7 +171,7 @@ def test_clockwise_faces_reversed_with_a_warning_each():
 
 @pytest.mark.parametrize(("flaw", "message"), [
     ("cross", "edges {e} and {e1} cross or overlap"),
-    ("twin_vertex", "edges 0 and {e} cross or overlap"),
+    ("twin_vertex", "edge {e} belongs to no face"),  # its edges lie on edges as a slit's
     ("z", "vertex {v} has z = 1 where other rows are 2D; give every vertex 2 coordinates, or 3 on one plane")])
 def test_flawed_grid_refused_naming_the_item(flaw, message):
     n = 60

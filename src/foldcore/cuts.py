@@ -155,7 +155,14 @@ def cut_note(split: Split) -> str:
 def welded_ids(vertices: np.ndarray):
     """(V,) int, for each vertex the smallest id at exactly the same point, or None
     when no two vertices coincide (the common case, found with one sort)."""
-    _, first, inverse = np.unique(vertices, axis=0, return_index=True, return_inverse=True)
-    if len(first) == len(vertices):
+    order = np.lexsort((vertices[:, 1], vertices[:, 0]))
+    ordered = vertices[order]
+    same = (ordered[1:] == ordered[:-1]).all(axis=1)
+    if not same.any():
         return None
-    return first[inverse.ravel()]
+    group = np.concatenate([[0], np.cumsum(~same)])  # runs of one point, in sorted order
+    smallest = np.full(group[-1] + 1, len(vertices), dtype=np.int64)
+    np.minimum.at(smallest, group, order)
+    out = np.empty(len(vertices), dtype=np.int64)
+    out[order] = smallest[group]
+    return out

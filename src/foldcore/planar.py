@@ -336,15 +336,12 @@ def derive_face_loops(vertices: np.ndarray, edges: np.ndarray, boundary: np.ndar
 
 
 def _check_pieces_apart(vertices, flat, lengths, source: str) -> None:
-    """PatternError naming a vertex that lies inside a face (``flat``, ``lengths``: the
-    faces' loops) of another piece (sheets drawn over each other), for a pattern of
-    several pieces; a piece inside another's hole is apart from it."""
+    """PatternError naming a vertex inside a face (loops ``flat``, ``lengths``) of another
+    piece (drawn over each other); a piece in another's hole is apart from it."""
     import shapely
 
-    rings = shapely.linearrings(vertices[flat], indices=np.repeat(np.arange(len(lengths)),
-                                                                    lengths))
-    faces = shapely.polygons(rings)
-    tree = shapely.STRtree(faces)
+    face_of = np.repeat(np.arange(len(lengths)), lengths)
+    tree = shapely.STRtree(shapely.polygons(shapely.linearrings(vertices[flat], indices=face_of)))
     inside, face = tree.query(shapely.points(vertices), predicate="within")
     if len(inside):
         k = int(np.argmin(inside))
