@@ -733,6 +733,46 @@ def test_fuzz_cp(fuzz_dir, blob):
     read_written(fuzz_dir, "p.cp", blob)
 
 
+@st.composite
+def opx_texts(draw) -> bytes:
+    """ORIPA's XML of generated ``.cp`` lines (:func:`cp_texts`, each field a property,
+    escaped), sometimes with an element renamed, a DTD with entities, or cut short."""
+    from xml.sax.saxutils import escape
+
+    from test_opx import HEAD, TAIL
+
+    lines = draw(cp_texts()).decode("utf-8", "replace").splitlines()
+    body = []
+    for i, line in enumerate(lines):
+        fields = line.split()
+        kinds = ["int"] + ["double"] * (len(fields) - 1)
+        props = "".join(f'<void property="{name}"><{kind}>{escape(value)}</{kind}></void>'
+                        for name, kind, value in zip(("type", "x0", "y0", "x1", "y1"), kinds,
+                                                     fields))
+        body.append(f'<void index="{i}"><object class="oripa.OriLineProxy">{props}</object>'
+                    "</void>")
+    text = HEAD.format(n=len(lines)) + "".join(body) + TAIL
+    twist = draw(st.integers(0, 7))
+    if twist == 0:
+        text = text.replace("<double>", "<string>", 1).replace("</double>", "</string>", 1)
+    elif twist == 1:
+        text = text.replace("<java", '<!DOCTYPE java [<!ENTITY a "aaaa">]><java', 1)
+    elif twist == 2:
+        text = text.replace('class="oripa.OriLineProxy"', 'class="x"', 1)
+    blob = text.encode("utf-8", "surrogatepass")
+    if draw(st.integers(0, 6)) == 0:
+        blob = blob[:draw(st.integers(0, len(blob)))]
+    return blob
+
+
+@FUZZ
+@given(blob=opx_texts())
+def test_fuzz_opx(fuzz_dir, blob):
+    """Generated ORIPA .opx files through :func:`foldcore.io.read`: a valid pattern or
+    one line naming the file."""
+    read_written(fuzz_dir, "p.opx", blob)
+
+
 # -------------------------------------------------------- plain regressions
 @pytest.mark.parametrize("path", ["bad\0name.fold", "bad\0name.obj", "bad\0name.stl"])
 def test_nul_in_path_refused(path):
@@ -748,13 +788,17 @@ def test_directory_refused(tmp_path, name):
         fio.read(tmp_path / name, hinges=tmp_path if name != "d.fold" else None)
 
 
-@pytest.mark.parametrize("suffix", [".fold", ".obj", ".stl", ".hinges", ".cp"])
+@pytest.mark.parametrize("suffix", [".fold", ".obj", ".stl", ".hinges", ".cp", ".opx"])
 def test_size_limit_every_reader(tmp_path, monkeypatch, suffix):
-    """FOLD, OBJ, STL, .cp and hinge files are all refused above MAX_FILE_BYTES, unopened."""
+    """FOLD, OBJ, STL, .cp, .opx and hinge files are all refused above MAX_FILE_BYTES,
+    unopened."""
+    from test_opx import opx_text
+
     p = BASES[2]
     fio.write_fold(tmp_path / "p.fold", p)
-    (tmp_path / "p.cp").write_text("".join(f"2 {a[0]} {a[1]} {b[0]} {b[1]}\n"
-                                           for a, b in p.vertices[p.edges]))
+    cp = [f"2 {a[0]} {a[1]} {b[0]} {b[1]}" for a, b in p.vertices[p.edges]]
+    (tmp_path / "p.cp").write_text("".join(line + "\n" for line in cp))
+    (tmp_path / "p.opx").write_text(opx_text(cp))
     fio.write_obj(tmp_path / "p.obj", p)
     fio.write_hinges(tmp_path / "p.hinges", p)
     (tmp_path / "p.stl").write_text(_ascii_stl([[(x, y, 0.0) for x, y in t]
@@ -772,7 +816,7 @@ def test_size_limit_every_reader(tmp_path, monkeypatch, suffix):
     monkeypatch.setattr("builtins.open", spy)
     mesh = tmp_path / ("small.obj" if suffix == ".hinges" else f"p{suffix}")
     with pytest.raises(PatternError, match=rf"p\{suffix}: file is {size} bytes.*{size - 1}"):
-        fio.read(mesh, hinges=tmp_path / "p.hinges" if suffix not in (".fold", ".cp")
+        fio.read(mesh, hinges=tmp_path / "p.hinges" if suffix not in (".fold", ".cp", ".opx")
                  else None)
     assert str(too_big) not in opened
 

@@ -145,10 +145,10 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def _add_simulate(sub) -> None:
-    sim = sub.add_parser("simulate", help="fold a crease pattern (FOLD, SVG, .cp, or "
-                                          "OBJ/STL + hinges)")
-    sim.add_argument("pattern", help="crease pattern: .fold, .svg, .cp, or .obj/.stl with a "
-                                     ".hinges file")
+    sim = sub.add_parser("simulate", help="fold a crease pattern (FOLD, SVG, .cp, .opx, "
+                                          "or OBJ/STL + hinges)")
+    sim.add_argument("pattern", help="crease pattern: .fold, .svg, .cp, .opx, or .obj/.stl "
+                                     "with a .hinges file")
     _add_reading(sim)
     _add_thickening(sim)
     _add_solving(sim)

@@ -38,7 +38,10 @@ def read(path, *, hinges=None, reading: Reading | None = None) -> CreasePattern:
 
 
 #: What each suffix without a hinge file is, for messages.
-_KINDS = {".fold": "a FOLD file", ".svg": "an SVG", ".cp": "a .cp file"}
+_KINDS = {".fold": "a FOLD file", ".svg": "an SVG", ".cp": "a .cp file",
+          ".opx": "an ORIPA .opx file"}
+#: Suffixes of the crease-pattern files read without a hinge file.
+_PATTERNS = tuple(_KINDS)
 
 
 def read_file(path, *, hinges=None, reading: Reading | None = None) -> FoldFile:
@@ -48,7 +51,8 @@ def read_file(path, *, hinges=None, reading: Reading | None = None) -> FoldFile:
     ----------
     path : str or os.PathLike
         ``.fold`` (FOLD JSON), ``.svg`` (Origami Simulator's colours,
-        :mod:`.svg`), ``.cp`` (ORIPA's lines, :mod:`.cp`), or ``.obj`` / ``.stl``
+        :mod:`.svg`), ``.cp`` (ORIPA's lines, :mod:`.cp`), ``.opx`` (ORIPA's
+        own files, :mod:`.opx`), or ``.obj`` / ``.stl``
         (2D polygon mesh, mm).
     hinges : str or os.PathLike, optional
         Hinge file of a mesh; default: the mesh path with suffix ``.hinges``.
@@ -74,11 +78,11 @@ def read_file(path, *, hinges=None, reading: Reading | None = None) -> FoldFile:
     source = os.fspath(path)
     suffix = Path(source).suffix.lower()
     reading = Reading() if reading is None else reading
-    if suffix in (".fold", ".svg", ".cp") and hinges is not None:
+    if suffix in _PATTERNS and hinges is not None:
         raise PatternError(f"{source}: a hinge file only goes with an OBJ/STL mesh, "
                            f"not {_KINDS[suffix]}")
     for given in (source, hinges):  # before any is opened: a named pipe blocks a read
-        if given is not None and suffix in (".fold", ".svg", ".cp", *MESH_SUFFIXES):
+        if given is not None and suffix in (*_PATTERNS, *MESH_SUFFIXES):
             check_input(given, PatternError)
     if suffix == ".fold":
         return read_fold_file(source, reading)
@@ -88,10 +92,13 @@ def read_file(path, *, hinges=None, reading: Reading | None = None) -> FoldFile:
     if suffix == ".cp":
         from .cp import read_cp
         return FoldFile(read_cp(source, reading), None, "mm")
+    if suffix == ".opx":
+        from .opx import read_opx
+        return FoldFile(read_opx(source, reading), None, "mm")
     if suffix in MESH_SUFFIXES:
         if reading.scale is not None or reading.size is not None:
             raise PatternError(f"{source}: a scale or sheet size applies to FOLD and SVG "
                                "patterns; an OBJ/STL mesh is read in mm")
         return FoldFile(read_mesh(source, hinges), None, "mm")
     raise PatternError(f"{source}: unknown crease-pattern file type {suffix or '(no suffix)'!r}"
-                       " (expected .fold, .svg, .cp, .obj or .stl)")
+                       " (expected .fold, .svg, .cp, .opx, .obj or .stl)")

@@ -55,8 +55,14 @@ def read_cp(path, reading: Reading | None = None) -> CreasePattern:
         a malformed pattern (named as :class:`CreasePattern` names it).
     """
     source = os.fspath(path)
+    return pattern_of_typed_lines(_lines(source), source, reading)
+
+
+def pattern_of_typed_lines(lines, source: str, reading: Reading | None) -> CreasePattern:
+    """The pattern of ORIPA's typed lines (``lines``: (S, 2, 2) segments, assignments,
+    targets, names), noded with :data:`MERGE` and scaled by ``reading``."""
+    segments, kinds, angles, owners = lines
     reading = Reading() if reading is None else reading
-    segments, kinds, angles, owners = _lines(source)
     if not len(segments):
         raise PatternError(f"{source}: no border, mountain or valley line (types 1, 2, 3)")
     check_meetings(segments, source)
@@ -74,20 +80,27 @@ def _lines(source: str):
     except UnicodeDecodeError:
         raise PatternError(f"{source}: not a text file (a .cp file is lines of "
                            "TYPE X1 Y1 X2 Y2)") from None
+    numbered = ((number, line) for number, line in enumerate(text.splitlines(), start=1)
+                if line.strip())
+    return typed_lines((_parse(line, number, source) + (f"line {number}",)
+                        for number, line in numbered), source)
+
+
+def typed_lines(parsed, source: str):
+    """(segments, assignments, targets, names) of ``parsed`` (TYPES entry, (2, 2)
+    segment, name) triples, the auxiliary lines left out (said once with a count);
+    more than :data:`MAX_LINES` refused."""
     segments, kinds, angles, owners, auxiliary = [], [], [], [], 0
-    for number, line in enumerate(text.splitlines(), start=1):
-        if not line.strip():
-            continue
+    for kind, segment, name in parsed:
         if len(segments) + auxiliary >= MAX_LINES:
             raise PatternError(f"{source}: more than {MAX_LINES} lines")
-        kind, segment = _parse(line, number, source)
         if kind is None:
             auxiliary += 1
             continue
         segments.append(segment)
         kinds.append(kind[0])
         angles.append(kind[1])
-        owners.append(f"line {number}")
+        owners.append(name)
     if auxiliary:
         note(source, f"{auxiliary} auxiliary lines (types 0 and 4) are not creases: "
                      "left out")
@@ -106,6 +119,12 @@ def _parse(text: str, number: int, source: str):
     except ValueError:
         raise PatternError(f"{where}: expected an integer type and four numbers, got "
                            f"{' '.join(fields)[:80]!r}") from None
+    return checked_line(kind, values, where)
+
+
+def checked_line(kind: int, values, where: str):
+    """(TYPES entry, (2, 2) segment) of a line of ``kind`` from (x1, y1, x2, y2)
+    ``values``; PatternError starting with ``where`` if either is out of range."""
     if kind not in TYPES:
         raise PatternError(f"{where}: type {kind} is not 1 (border), 2 (mountain), "
                            "3 (valley) or 0/4 (auxiliary)")
