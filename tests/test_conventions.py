@@ -107,6 +107,27 @@ def test_a_folded_form_reads_its_flat_unfold_coordinates():
     assert any("vertices_flatUnfoldCoords" in m for m in said)
 
 
+@pytest.mark.parametrize("inherit", [True, False])
+def test_a_folded_key_frame_reads_the_crease_pattern_frame_of_its_file_frames(inherit):
+    """Rabbit Ear writes a flat-folded key frame (2D, its layers over each other:
+    labelled foldedForm) and the crease pattern in file_frames, labelled creasePattern,
+    inheriting the key frame's edges or holding its own."""
+    cp = json.load(open("tests/data/real/diagonal-cp.fold"))
+    folded = json.load(open("tests/data/real/diagonal-folded.fold"))
+    flat, _ = read_said(cp)
+    key = {k: v for k, v in folded.items() if k != "vertices_flatUnfoldCoords"}
+    key["vertices_coords"] = [row[:2] for row in key["vertices_coords"]]
+    frame = {"frame_classes": ["creasePattern"], "vertices_coords": cp["vertices_coords"]}
+    if inherit:
+        frame.update(frame_inherit=True, frame_parent=0)
+    else:
+        frame.update({k: v for k, v in cp.items() if k.startswith(("edges_", "faces_"))})
+    pattern, said = read_said({**key, "file_frames": [{"frame_title": "other"}, frame]})
+    np.testing.assert_allclose(pattern.vertices, flat.vertices)
+    np.testing.assert_array_equal(pattern.edges, flat.edges)
+    assert [m for m in said if "file_frames[1] (frame_classes: creasePattern)" in m]
+
+
 def test_a_folded_form_without_flat_coordinates_is_refused_saying_what_would_do():
     with pytest.raises(PatternError) as info:
         read_said(json.load(open("tests/data/real/simple.fold")))

@@ -18,7 +18,9 @@ al. 2018), so foldcore reads them as it does (its ``js/importer.js`` and
   side — the side valleys fold towards — stays on top.
 * **A folded form** (``frame_classes`` ``foldedForm``, or coordinates off a
   plane) is read through its ``vertices_flatUnfoldCoords``; without them it is
-  refused with a message saying which keys would do.
+  refused with a message saying which keys would do. A key frame labelled a
+  folded form whose ``file_frames`` hold a frame labelled ``creasePattern``
+  (Rabbit Ear's files) is read from that frame (:func:`crease_pattern_frame`).
 * **Lengths**: ``frame_unit`` as before (a unit-square file is 1 mm wide);
   :attr:`Reading.scale` multiplies every length of the file, or
   :attr:`Reading.size` sets the sheet's larger extent in mm.
@@ -85,6 +87,33 @@ class Reading:
         if self.size is not None:
             return self.size / extent_mm if extent_mm > 0 else 1.0
         return 1.0 if self.scale is None else self.scale
+
+
+#: Key suffixes of per-element arrays (a frame's geometry), with or without a prefix.
+ELEMENT_KEYS = ("vertices_", "edges_", "faces_")
+
+
+def crease_pattern_frame(d: dict, source: str) -> dict:
+    """The FOLD object whose frame is the crease pattern: ``d`` itself, or, when its
+    key frame is labelled ``foldedForm`` without ``vertices_flatUnfoldCoords`` and a
+    frame of its ``file_frames`` is labelled ``creasePattern``, that frame (said
+    once) over the key frame's file-level keys — and over its geometry too where
+    the frame inherits from it (``frame_inherit`` with ``frame_parent`` 0 or absent)."""
+    from .fold_json import ARRAY, has_class
+
+    frames = d.get("file_frames")
+    if not has_class(d.get("frame_classes"), "foldedForm") or not isinstance(frames, ARRAY) \
+            or d.get("vertices_flatUnfoldCoords") is not None:
+        return d
+    for i, frame in enumerate(frames):
+        if isinstance(frame, dict) and has_class(frame.get("frame_classes"), "creasePattern"):
+            inherits = frame.get("frame_inherit") is True and frame.get("frame_parent", 0) == 0
+            base = {k: v for k, v in d.items() if k not in ("file_frames", "frame_classes")
+                    and (inherits or not str(k).split(":")[-1].startswith(ELEMENT_KEYS))}
+            note(source, f"the key frame is a folded form: the crease pattern is read from "
+                         f"file_frames[{i}] (frame_classes: creasePattern)")
+            return {**base, **frame}
+    return d
 
 
 def note(source: str, message: str) -> None:

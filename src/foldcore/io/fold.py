@@ -62,7 +62,8 @@ from ..files import check_input
 from ..hinges import HINGE_MODELS
 from ..pattern import DEFAULT_MAX_ANGLE_DEG, CreasePattern
 from ..planar import Loops, derive_face_loops, freeze, has_repeats, loop_starts, next_in_loop
-from .conventions import Reading, assigned_angles, into_plane, note, trust_signs
+from .conventions import (Reading, assigned_angles, crease_pattern_frame, into_plane, note,
+                          trust_signs)
 from .fold_json import (ARRAY, CELLS_KEY, EDGE_STIFFNESS_KEY,  # noqa: F401  (part of this API)
                         FACE_STIFFNESS_KEY, HINGE_KEY, MAX_ANGLE_KEY, POISSON_KEY, TARGET_KEY,
                         THICKNESS_KEY, UNIT_MM, WIDTH_KEY, check_length, fail, has_class, index,
@@ -174,6 +175,7 @@ def _fold_file(d, source: str, reading: Reading | None, owned: bool) -> FoldFile
     reading = Reading() if reading is None else reading
     if not isinstance(d, dict):
         fail(source, f"the top level must be a JSON object, got {type(d).__name__}")
+    d = crease_pattern_frame(d, source)
     unit, scale = _unit_scale(d, source)
     rows = _crease_pattern_coords(d, source)
     faces = _faces(d, len(rows), source)
