@@ -1113,3 +1113,34 @@ def test_facet_folded_by_a_compatible_hinge_stays_unstrained():
         rest = cells.rest[cells.slots(i)]
         d_rest = np.linalg.norm(rest[:, None] - rest[None], axis=2)
         assert np.abs(d_now - d_rest).max() <= 1e-6 * 20.0
+
+
+# ------------------------------------------------------- widths fitted to small faces
+def _strip_with_small_face():
+    """A 100 × 10 mm strip with a 1 mm face at its left end: its crease x = 1 in two
+    collinear halves (meeting a crease along y = 5 that runs to the right end)."""
+    xy = [(0, 0), (1, 0), (100, 0), (100, 10), (1, 10), (0, 10), (1, 5), (100, 5)]
+    edges = [(0, 1), (1, 2), (2, 7), (7, 3), (3, 4), (4, 5), (5, 0), (1, 6), (6, 4), (6, 7)]
+    kinds = ["B"] * 7 + ["V", "V", "M"]
+    return CreasePattern(xy, edges, kinds, fold_angles=[None] * 7 + [90.0, 90.0, -90.0])
+
+
+def test_automatic_widths_too_wide_for_a_face_are_narrowed_with_their_collinear_creases():
+    """Eq. 7's width at H = 2 mm (π mm) would inset the 1 mm face to nothing: its side's
+    two collinear halves are halved together (a straight panel side keeps one inset),
+    the crease elsewhere keeps Eq. 7's width; said once, in the mesh and the report."""
+    from foldcore.errors import PatternWarning
+    from foldcore.outputs import _narrowed_entries
+
+    pattern = _strip_with_small_face()
+    eq7 = minimum_hinge_width(2.0, 180.0)
+    with pytest.warns(PatternWarning, match=r"2 hinges narrowed to fit small faces \(edge 7, "
+                                            r"…; down to 0\.5 of Eq\. 7's width\)"):
+        mesh = thicken(pattern, 2.0)
+    np.testing.assert_allclose(mesh.hinge_width[7:], [eq7 / 2, eq7 / 2, eq7])
+    assert mesh.width_share[7:].tolist() == [0.5, 0.5, 1.0]
+    entries = _narrowed_entries(mesh)["narrowed_hinges"]
+    assert [e["edge"] for e in entries] == [7, 8] and entries[0]["share_of_eq7"] == 0.5
+    assert thicken(pattern.replace(vertices=pattern.vertices * 10), 2.0).width_share is None
+    with pytest.raises(MeshError, match="face 0: hinge widths are too large for this face"):
+        thicken(pattern, 2.0, hinge_width=eq7)  # widths the user gave are kept

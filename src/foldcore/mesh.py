@@ -92,6 +92,10 @@ class ThickMesh:
         ``pattern.edge_faces[e]`` (−1 where there is none): the panel, or on an
         elastic face the cell nearest the crease's middle, so a bent face does
         not count as fold. Default: ``panel_of_face`` of both faces.
+    width_share : (E,) float64, optional
+        The share of Eq. 7's width each crease kept where a face was too small for
+        it (:func:`foldcore.thickening.widths.fit_widths`); None when none was
+        narrowed.
     """
 
     points: np.ndarray
@@ -106,6 +110,7 @@ class ThickMesh:
     elastic: dict = field(default_factory=dict)
     hinge_model: np.ndarray | None = None
     crease_panels: np.ndarray | None = None
+    width_share: np.ndarray | None = None
 
     def __post_init__(self):
         if self.segments is None:

@@ -243,6 +243,7 @@ def report_dict(result, pattern, mesh, settings: dict, quantities: dict | None =
         "vertices": int(mesh.n_vertices),
         "elements": {name: len(g) for name, g in mesh.groups.items()},
         "hinge_width_mm": nullable(mesh.hinge_width),
+        **_narrowed_entries(mesh),
         "subdivisions": mesh.subdivisions.tolist(),
         "timings_s": {k: float(v) for k, v in result.timings_s.items()},
         **_iteration_cost(result),
@@ -250,6 +251,17 @@ def report_dict(result, pattern, mesh, settings: dict, quantities: dict | None =
         **({"quantities": quantities} if quantities else {}),
         "machine": machine_entries(),
     }
+
+
+def _narrowed_entries(mesh) -> dict:
+    """The hinges narrowed to fit small faces, each with the share of Eq. 7's width it
+    kept (nothing when none was)."""
+    share = getattr(mesh, "width_share", None)
+    if share is None:
+        return {}
+    return {"narrowed_hinges": [{"edge": int(e), "width_mm": float(mesh.hinge_width[e]),
+                                 "share_of_eq7": float(share[e])}
+                                for e in np.flatnonzero(share < 1.0)]}
 
 
 def machine_entries() -> dict:

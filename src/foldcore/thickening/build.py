@@ -1,10 +1,12 @@
 """thicken(): the steps from a crease pattern to its ThickMesh."""
 from __future__ import annotations
 
+import warnings
 from typing import NamedTuple
 
 import numpy as np
 
+from ..errors import MeshError, PatternWarning
 from ..limits import check_mesh_size
 from ..mesh import ThickMesh
 from ..pattern import CreasePattern
@@ -15,7 +17,8 @@ from .inputs import (check_stiffness, check_thickness, mesh_vertices, plate_coun
                      resolve_stretch, split_elastic, strip_segments)
 from .panels import panel_corners, panel_loops
 from .strips import build_strips
-from .widths import resolve_hinges, resolve_subdivisions, resolve_widths
+from .widths import (automatic_widths, fit_widths, resolve_hinges, resolve_subdivisions,
+                     resolve_widths)
 
 __all__ = ["thicken"]
 
@@ -73,6 +76,18 @@ def thicken(pattern: CreasePattern, thickness: float, hinge_width=None,
     """
     sheet = _resolve(pattern, thickness, hinge_width, subdivisions, bend_radius, hinge,
                      stiffness, stretch)
+    try:
+        return _build(sheet, elastic, cell_size)
+    except MeshError:  # a face or crease too small for automatic widths: narrow them
+        narrowed = _narrowed(sheet, hinge_width, subdivisions)
+        if narrowed is None:
+            raise
+    return _build(narrowed, elastic, cell_size)
+
+
+def _build(sheet, elastic, cell_size) -> ThickMesh:
+    """:func:`thicken`'s mesh of its resolved ``sheet``."""
+    pattern = sheet.pattern
     table = PointTable()
     corners, corner_ids = panel_corners(pattern, sheet.widths, table)
     bars, plates, facets = split_elastic(pattern, elastic)
@@ -96,6 +111,7 @@ class _Sheet(NamedTuple):
     widths: np.ndarray  # (E,) hinge width, mm (NaN on boundary edges)
     hinges: np.ndarray  # (E,) hinge model name ("" on boundary edges)
     ks: np.ndarray  # (E,) sub-strips per hinge (1 on stretch hinges, 0 on boundary edges)
+    share: np.ndarray | None  # (E,) share of Eq. 7's width kept (None: none narrowed)
     stretch: dict  # {crease: ν}
     stiffness: dict  # {"panel": factors, "hinge": factors}, as given
 
@@ -112,7 +128,26 @@ def _resolve(pattern, thickness, hinge_width, subdivisions, bend_radius, hinge, 
     ks = resolve_subdivisions(pattern, widths, thickness, subdivisions, hinges)
     stretch = resolve_stretch(pattern, stretch)
     ks[list(stretch)] = 1
-    return _Sheet(pattern, thickness, widths, hinges, ks, stretch, stiffness or {})
+    return _Sheet(pattern, thickness, widths, hinges, ks, None, stretch, stiffness or {})
+
+
+def _narrowed(sheet: _Sheet, hinge_width, subdivisions) -> _Sheet | None:
+    """The sheet with the automatic widths around faces and creases too small for them
+    narrowed (said once; :func:`.widths.fit_widths`) and its sub-strips chosen again;
+    None when no automatic width is in the way."""
+    pattern = sheet.pattern
+    share = fit_widths(pattern, sheet.widths, automatic_widths(pattern, hinge_width))
+    if (share == 1.0).all():
+        return None
+    widths = sheet.widths * share
+    ks = resolve_subdivisions(pattern, widths, sheet.thickness, subdivisions, sheet.hinges)
+    ks[list(sheet.stretch)] = 1
+    narrowed = np.flatnonzero(share < 1.0)
+    warnings.warn(f"{pattern.source}: {len(narrowed)} hinge{'s' if len(narrowed) != 1 else ''} "
+                  f"narrowed to fit small faces (edge {int(narrowed[0])}, …; down to "
+                  f"{share.min():g} of Eq. 7's width): they bind before their full fold; "
+                  "give thickening.hinge_width (mm) for others", PatternWarning, stacklevel=3)
+    return sheet._replace(widths=widths, ks=ks, share=share)
 
 
 def _assemble(sheet: _Sheet, points, strip_points, loops, cells, segments, built) -> ThickMesh:
@@ -133,4 +168,5 @@ def _assemble(sheet: _Sheet, points, strip_points, loops, cells, segments, built
                      panel_of_face=panel_of_face,
                      strips_of_crease=strips_of, hinge_width=sheet.widths, subdivisions=sheet.ks,
                      segments=segments, elastic=built, hinge_model=sheet.hinges,
-                     crease_panels=crease_panels(pattern, points, cells, panel_of_face))
+                     crease_panels=crease_panels(pattern, points, cells, panel_of_face),
+                     width_share=sheet.share)

@@ -6,7 +6,7 @@ import numpy as np
 from ..errors import MeshError
 from .geometry import cross2d
 
-__all__ = ["corner_lookup", "panel_corners", "panel_loops"]
+__all__ = ["corner_lookup", "inset_faces", "panel_corners", "panel_loops"]
 
 
 def _inset_corners(p, offsets):
@@ -60,6 +60,28 @@ def _inset_fails(p, corners) -> np.ndarray:
     return flipped | ~shapely.is_valid(shapely.polygons(corners))
 
 
+def _faces_by_size(pattern) -> list:
+    """The face ids grouped by vertex count (each group's insets computed at once)."""
+    by_size: dict[int, list[int]] = {}
+    for f, face in enumerate(pattern.faces):
+        by_size.setdefault(len(face), []).append(f)
+    return list(by_size.values())
+
+
+def inset_faces(pattern, widths):
+    """(corners, failing): each face's inset corners ((m, 2) mm) by half of ``widths``
+    (E,) mm, and (F,) bool, the faces whose panel that makes vanish or turn inside out."""
+    offsets = _face_offsets(pattern, widths)
+    corners, failing = [None] * len(pattern.faces), np.zeros(len(pattern.faces), dtype=bool)
+    for group in _faces_by_size(pattern):
+        p = pattern.vertices[np.array([pattern.faces[f] for f in group])]
+        inset = _inset_corners(p, np.array([offsets[f] for f in group]))[0]
+        failing[group] = _inset_fails(p, inset)
+        for row, f in enumerate(group):
+            corners[f] = inset[row]
+    return corners, failing
+
+
 def panel_corners(pattern, widths, table):
     """Each face's inset corners ((m, 2) mm) and their point ids (added to ``table``
     face by face), the faces of one vertex count computed together
@@ -67,11 +89,8 @@ def panel_corners(pattern, widths, table):
     whose inset fails."""
     offsets = _face_offsets(pattern, widths)
     corners = [None] * len(pattern.faces)
-    by_size: dict[int, list[int]] = {}
-    for f, face in enumerate(pattern.faces):
-        by_size.setdefault(len(face), []).append(f)
     failed = {}  # face → message
-    for group in by_size.values():
+    for group in _faces_by_size(pattern):
         p = pattern.vertices[np.array([pattern.faces[f] for f in group])]
         inset, mismatched = _inset_corners(p, np.array([offsets[f] for f in group]))
         fails = _inset_fails(p, inset)

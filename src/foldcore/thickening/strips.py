@@ -48,6 +48,17 @@ def build_strips(pattern, widths, ks, segments, corners, corner_ids, table) -> t
     return strip_points, inserts
 
 
+def short_creases(pattern, corners) -> np.ndarray:
+    """(E,) bool: the creases whose strip the panels' ``corners`` cut back past its
+    length (at acute corners, a panel's inset corner lies along the crease)."""
+    place = corner_lookup(pattern)
+    lengths = pattern.edge_lengths()
+    out = np.zeros(pattern.n_edges, dtype=bool)
+    for e in pattern.creases:
+        out[e] = sum(_strip_cuts(pattern, e, corners, place)) >= lengths[e] * (1 - 1e-9)
+    return out
+
+
 def _strip_cuts(pattern, e, corners, place) -> tuple[float, float]:
     """Distances (mm) from each crease end to where its strip starts (≥ 0); ``place``:
     :func:`.panels.corner_lookup`."""

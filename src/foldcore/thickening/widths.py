@@ -7,10 +7,14 @@ from ..errors import MeshError
 from ..hinges import DEFAULT_HINGE, HINGE_MODELS
 from ..limits import SUBDIVISIONS
 
-__all__ = ["MAX_SUBDIVISIONS", "auto_subdivisions", "minimum_hinge_width", "resolve_hinges",
-           "resolve_subdivisions", "resolve_widths"]
+__all__ = ["MAX_NARROWING", "MAX_SUBDIVISIONS", "auto_subdivisions", "automatic_widths",
+           "fit_widths", "minimum_hinge_width", "resolve_hinges", "resolve_subdivisions",
+           "resolve_widths"]
 
 MAX_SUBDIVISIONS = 16
+#: Halvings of an automatic hinge width that fitting it to a small face may take
+#: (down to 1/64 of Eq. 7's width).
+MAX_NARROWING = 6
 
 
 def minimum_hinge_width(thickness: float, max_angle_deg, bend_radius: float = 0.0):
@@ -66,6 +70,76 @@ def resolve_widths(pattern, thickness, hinge_width, bend_radius) -> np.ndarray:
     if len(bad):
         raise MeshError(f"{pattern.source}: edge {bad[0]}: hinge width must be > 0 mm")
     return widths
+
+
+def automatic_widths(pattern, hinge_width) -> np.ndarray:
+    """(E,) bool: the creases whose width is Eq. 7's (neither ``hinge_width`` nor the
+    pattern gives one)."""
+    given = np.array(pattern.widths, dtype=float) if hinge_width is None else \
+        np.broadcast_to(np.asarray(hinge_width, dtype=float), (pattern.n_edges,))
+    return np.isnan(given) & (pattern.assignments != "B")
+
+
+def fit_widths(pattern, widths, automatic) -> np.ndarray:
+    """(E,) share of its width each crease keeps: the ``automatic`` widths (Eq. 7's,
+    :func:`automatic_widths`) in the way halved, at most :data:`MAX_NARROWING` times,
+    until every face's panel survives its inset (:func:`.panels.inset_faces`) and
+    every crease keeps a strip (:func:`.strips.short_creases`). In the way: the sides
+    of a face too small, the creases at either end of a crease too short. A crease
+    is narrowed with the creases collinear with it through a vertex
+    (:func:`collinear_groups`: a panel's straight side keeps one inset). Widths the
+    user gave are kept; a face or crease still too small is refused when the mesh
+    is built."""
+    from .panels import inset_faces
+    from .strips import short_creases
+
+    share = np.ones(len(widths))
+    group = collinear_groups(pattern)
+    for _ in range(MAX_NARROWING):
+        corners, failing = inset_faces(pattern, widths * share)
+        around = np.isin(pattern.edge_faces, np.flatnonzero(failing)).any(axis=1)
+        if not failing.any():
+            ends = np.unique(pattern.edges[short_creases(pattern, corners)])
+            around = np.isin(pattern.edges, ends).any(axis=1)
+        around &= automatic
+        if not around.any():
+            break
+        share[np.isin(group, group[around]) & automatic] *= 0.5
+    return share
+
+
+def collinear_groups(pattern) -> np.ndarray:
+    """(E,) int: edges joined where two consecutive sides of a face run straight on
+    through their vertex (one label per joined set)."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    from ..planar import loop_starts, next_in_loop
+
+    loops = pattern.face_loops
+    following = next_in_loop(loop_starts(loops.lengths), loops.lengths)
+    side = _side_edges(pattern, loops.flat, loops.flat[following])
+    before = np.empty_like(following)
+    before[following] = np.arange(len(following))   # the side ending at each corner
+    xy = pattern.vertices
+    d_in = xy[loops.flat] - xy[loops.flat[before]]
+    d_out = xy[loops.flat[following]] - xy[loops.flat]
+    cross = d_in[:, 0] * d_out[:, 1] - d_in[:, 1] * d_out[:, 0]
+    dot = np.einsum("ij,ij->i", d_in, d_out)
+    straight = (np.abs(cross) <= 1e-9 * np.abs(dot)) & (dot > 0)
+    n = pattern.n_edges
+    graph = coo_matrix((np.ones(int(straight.sum())), (side[before][straight], side[straight])),
+                       shape=(n, n))
+    return connected_components(graph, directed=False)[1]
+
+
+def _side_edges(pattern, u, v) -> np.ndarray:
+    """The edge id of each face side u → v."""
+    n = pattern.n_vertices
+    keys = np.minimum(pattern.edges[:, 0], pattern.edges[:, 1]) * n \
+        + np.maximum(pattern.edges[:, 0], pattern.edges[:, 1])
+    order = np.argsort(keys)
+    return order[np.searchsorted(keys[order], np.minimum(u, v) * n + np.maximum(u, v))]
 
 
 def resolve_hinges(pattern, hinge) -> np.ndarray:
