@@ -35,7 +35,10 @@ share of all cores other processes used during each run.
 bare git directory, e.g. Origami Simulator's) in this process, after one
 warm-up read, and sorts each into read (vertices, edges, seconds) or
 refused, grouped by the kind of its one-line message, or crashed (any other
-exception: the reader's bug); writes bench/results/reading_svgs.json.
+exception: the reader's bug); each file read is thickened too at
+``THICK_MM`` (``foldcore.thicken``'s defaults): built, built with hinges
+narrowed to fit small faces, or refused by the first words of its message;
+writes bench/results/reading_svgs.json.
 
 Run: ``python bench/reading.py [--before ../main/src]`` (~25 min with
 --before) or ``--quick``; writes bench/results/reading.json and .png;
@@ -48,6 +51,7 @@ from __future__ import annotations
 import collections
 import json
 import os
+import re
 import resource
 import subprocess
 import sys
@@ -244,8 +248,28 @@ def svg_files(source: Path, into: Path) -> list[Path]:
     return sorted(source.rglob("*.svg"))
 
 
+#: Thickness (mm) at which ``--svgs`` thickens each file read.
+THICK_MM = 1.0
+
+
+def thick_outcome(pattern) -> str:
+    """``built``, ``built, narrowed`` or the start of the refusal of ``pattern``
+    thickened at :data:`THICK_MM`."""
+    import foldcore
+
+    with warnings.catch_warnings(record=True) as said:
+        warnings.simplefilter("always")
+        try:
+            foldcore.thicken(pattern, THICK_MM)
+        except foldcore.FoldcoreError as exc:
+            words = re.sub(r"\d+(\.\d+)?", "N", str(exc).split(": ", 1)[-1])
+            return "refused: " + re.sub(r"\(.*", "", words).split(";")[0].strip()[:60]
+    return "built, narrowed" if any("narrowed" in str(w.message) for w in said) else "built"
+
+
 def read_svg(path: Path) -> dict:
-    """One SVG read in this process: read, refused (by kind) or crashed; seconds."""
+    """One SVG read in this process: read, refused (by kind) or crashed; seconds; and
+    what thickening it does (:func:`thick_outcome`)."""
     import foldcore
 
     start = time.perf_counter()
@@ -261,7 +285,10 @@ def read_svg(path: Path) -> dict:
                      "message": message}
         except Exception as exc:  # noqa: BLE001  (a crash is the reader's bug: counted)
             entry = {"read": False, "kind": "crash", "message": repr(exc)}
-    return {**entry, "seconds": time.perf_counter() - start}
+    entry["seconds"] = time.perf_counter() - start
+    if entry["read"]:
+        entry["thick"] = thick_outcome(p)
+    return entry
 
 
 def svgs(args) -> None:
@@ -275,8 +302,11 @@ def svgs(args) -> None:
                 for p in files]
     counts = collections.Counter("read" if e["read"] else "refused: " + e["kind"]
                                  for e in each)
-    record.write({"files": len(each), "counts": dict(counts), "each": each})
-    print(json.dumps(dict(counts), indent=1))
+    thick = collections.Counter(e["thick"] for e in each if e["read"])
+    record.write({"files": len(each), "counts": dict(counts), "thick_mm": THICK_MM,
+                  "thick_counts": dict(thick), "each": each})
+    print(json.dumps({"read": dict(counts), f"thickened at {THICK_MM:g} mm": dict(thick)},
+                     indent=1))
 
 
 def plot(data: dict, path: Path) -> None:
@@ -338,8 +368,13 @@ def svgs_table(data: dict) -> str:
     counts = dict(data["counts"])
     crashed = counts.pop("refused: crash", 0)
     rows = sorted(counts.items(), key=lambda kv: (kv[0] != "read", -kv[1]))
-    return _meta.markdown_table(["outcome", "files"],
-                                [[k, str(v)] for k, v in rows + [("crashed", crashed)]])
+    table = _meta.markdown_table(["outcome", "files"],
+                                 [[k, str(v)] for k, v in rows + [("crashed", crashed)]])
+    thick = sorted(data.get("thick_counts", {}).items(), key=lambda kv: -kv[1])
+    if thick:
+        table += "\n\n" + _meta.markdown_table(
+            [f"thickened at {data['thick_mm']:g} mm", "files"], [[k, str(v)] for k, v in thick])
+    return table
 
 
 def main() -> None:
