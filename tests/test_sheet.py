@@ -252,3 +252,27 @@ def test_a_crease_ending_inside_a_face_folds_as_a_crease():
     assert (sheet.hinge_edge == 5).sum() == 1  # one hinge: triangles on both sides
     fold = fold_sheet(sheet, 100.0, pattern_edges=pattern.n_edges)
     assert fold.converged and 0.0 < fold.fold_angles_deg[5] < 20.0
+
+
+def test_straight_vertices_merge_unless_their_chord_would_cross_a_line():
+    """A valley line drawn in four pieces with a crease up from its middle vertex: its
+    two other degree-2 vertices merge (their chords run on along the line, past the
+    rest of it). A near-straight vertex whose chord would cut across a crease's end
+    (a crease from the bottom stops between the chord and the vertex) stays."""
+    from foldcore.pattern import CreasePattern
+
+    xy = [(0, 0), (100, 0), (100, 100), (0, 100), (0, 50), (30, 50), (60, 50), (70, 50),
+          (100, 50), (60, 100)]
+    edges = [(0, 1), (1, 8), (8, 2), (2, 9), (9, 3), (3, 4), (4, 0),
+             (4, 5), (5, 6), (6, 7), (7, 8), (6, 9)]
+    kinds = ["B"] * 7 + ["V"] * 4 + ["M"]
+    line = CreasePattern(xy, edges, kinds, fold_angles=[None] * 7 + [10.0] * 4 + [-10.0])
+    assert build_sheet(line, merge_straight=True).merged[:, 0].tolist() == [5, 7]
+    xy = [(0, 0), (40, 0), (100, 0), (100, 50), (100, 100), (0, 100), (0, 50), (50, 53),
+          (40, 51)]
+    edges = [(0, 1), (1, 2), (2, 3), (3, 4), (4, 5), (5, 6), (6, 0), (6, 7), (7, 3), (1, 8)]
+    bent = CreasePattern(xy, edges, ["B"] * 7 + ["V", "V", "M"],
+                         fold_angles=[None] * 7 + [10.0, 10.0, -10.0])
+    sheet = build_sheet(bent, merge_straight=True)   # |cos + 1| = 0.007 at vertex 7
+    assert len(sheet.merged) == 0
+    assert fold_sheet(sheet, 100.0, pattern_edges=bent.n_edges).converged

@@ -175,7 +175,10 @@ def segments_meet(p, q, a, b) -> np.ndarray:
 
     o1, o2 = orient(p, q, a), orient(p, q, b)
     o3, o4 = orient(a, b, p), orient(a, b, q)
-    return (o1 * o2 <= 0) & (o3 * o4 <= 0)
+    d = np.asarray(q, dtype=float) - p
+    along_a, along_b = (a - p) @ d, (b - p) @ d     # on one line: do their spans overlap?
+    overlap = (np.maximum(along_a, along_b) >= 0) & (np.minimum(along_a, along_b) <= d @ d)
+    return np.where((o1 == 0) & (o2 == 0), overlap, (o1 * o2 <= 0) & (o3 * o4 <= 0))
 
 
 def _inside(point, ring: np.ndarray) -> bool:
