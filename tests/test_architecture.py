@@ -160,7 +160,7 @@ def test_the_import_graph_has_no_cycle():
 #: of a layer above its own. The data side (pattern, thick mesh, readers) is below all.
 LAYERS = [
     ("foldcore.cli", "foldcore.demo", "foldcore.warmup", "foldcore.__main__",
-     "foldcore.interrupts"),
+     "foldcore.interrupts", "foldcore.result_commands"),
     ("foldcore.job", "foldcore.scenes", "foldcore.sheet_job"),
     ("foldcore.animate", "foldcore.view", "foldcore.outputs", "foldcore.render",
      "foldcore.fabrication", "foldcore.destinations", "foldcore.result_file",
@@ -173,7 +173,8 @@ LAYERS = [
     ("foldcore.thickening", "foldcore.io", "foldcore.pattern", "foldcore.mesh",
      "foldcore.measure", "foldcore.strain", "foldcore.patterns", "foldcore.planar",
      "foldcore.kinematics", "foldcore.limits", "foldcore.hinges", "foldcore.actuation",
-     "foldcore.errors", "foldcore.files", "foldcore.triangulation", "elements"),
+     "foldcore.errors", "foldcore.files", "foldcore.triangulation", "foldcore.cuts",
+     "elements"),
 ]
 
 

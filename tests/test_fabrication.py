@@ -424,3 +424,36 @@ def test_a_pattern_given_for_a_result_is_asked_for_a_result_fold(tmp_path, capsy
         (line,) = capsys.readouterr().err.splitlines()
         assert "not a result FOLD file" in line and "simulate PATTERN -o" in line, line
     assert not (tmp_path / "x.stl").exists() and not (tmp_path / "x.html").exists()
+
+
+# ------------------------------------------------------------------ thin sheets
+def test_a_thin_sheets_result_exports_its_lines_and_its_folded_triangles(tmp_path):
+    """A square cut in two flaps folded opposite ways with no thickness: the SVG and DXF
+    hold each edge once as an open line in its layer (the cut's two sides drawn once),
+    the STL the folded triangles at the result's positions, area kept."""
+    flaps = tmp_path / "flaps.fold"
+    flaps.write_text(json.dumps({
+        "file_spec": 1.1, "frame_unit": "mm",
+        "vertices_coords": [[0, 0], [50, 0], [100, 0], [100, 50], [100, 100], [0, 100],
+                            [0, 50], [50, 50]],
+        "edges_vertices": [[0, 1], [1, 2], [2, 3], [3, 4], [4, 5], [5, 6], [6, 0], [6, 7],
+                           [7, 3], [1, 7]],
+        "edges_assignment": ["B"] * 7 + ["V", "M", "C"],
+        "edges_foldAngle": [None] * 7 + [90, -90, None]}))
+    result = tmp_path / "flaps-out.fold"
+    assert main(["simulate", str(flaps), "-o", str(result), "-q"]) == 0
+    svg, dxf, stl = tmp_path / "f.svg", tmp_path / "f.dxf", tmp_path / "f.stl"
+    assert main(["export", str(result), "--svg", str(svg), "--dxf", str(dxf),
+                 "--stl", str(stl)]) == 0
+    layers = {g.get("id"): g for g in ET.parse(svg).getroot().iter(f"{SVG_NS}g")}
+    lines = {k: len(g.findall(f"{SVG_NS}polyline")) for k, g in layers.items()}
+    assert lines == {"cut": 8, "hinge_m": 1, "hinge_v": 1}  # 7 border edges + the cut
+    ezdxf = pytest.importorskip("ezdxf")
+    polylines = ezdxf.readfile(str(dxf)).modelspace().query("LWPOLYLINE")
+    assert len(polylines) == 10 and not any(p.closed for p in polylines)
+    res = read_result(result, thin=True)
+    solid = _trimesh_of(stl.read_bytes(), tmp_path)
+    assert solid.area == pytest.approx(100.0 * 100.0, rel=1e-6)
+    assert len(stl.read_bytes()) == 84 + 50 * len(res.triangles)
+    lowest = float(np.asarray(res.frames[-1].positions)[:, 2].min())
+    assert solid.bounds[0, 2] == pytest.approx(lowest, abs=1e-4)

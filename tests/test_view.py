@@ -103,8 +103,8 @@ def test_a_thin_sheets_result_shows_its_folded_triangles(tmp_path):
     """A result folded with no thickness (the thin sheet) has no thick mesh to rebuild:
     ``view`` shows its folded triangles (grey facets, the creases drawn over them in
     their M/V colours) and ``render`` draws them with the creases in their colours,
-    instead of refusing it; ``render --color-by`` (a thick sheet's strips) and
-    ``export`` still say they need a thick result."""
+    instead of refusing it; ``render --color-by`` (a thick sheet's strips) still says
+    it needs a thick result."""
     result, page = tmp_path / "wb.fold", tmp_path / "wb.html"
     assert main(["simulate", "tests/data/real/waterbombBase.svg", "--fold-percent", "80",
                  "-o", str(result), "-q"]) == 0
@@ -115,7 +115,6 @@ def test_a_thin_sheets_result_shows_its_folded_triangles(tmp_path):
     image = screenshot(page, tmp_path, "frame=0")
     assert int((image.sum(axis=2) < 740).sum()) > 1000  # the sheet is drawn
     assert count(image, "red") > 0 and count(image, "blue") > 0  # the M/V crease lines
-    assert main(["export", str(result), "--stl", str(tmp_path / "wb.stl")]) == 2
     picture = tmp_path / "wb.png"
     assert main(["render", str(result), "-o", str(picture), "--size", "320x240"]) == 0
     drawn = screenshot_of(picture)

@@ -29,7 +29,7 @@ from .hinges import DEFAULT_HINGE, HINGE_MODELS
 from .actuation import ACTUATIONS, BRANCH_FLOOR_DEG, DEFAULT_ACTUATION
 from .destinations import check_destinations
 from .errors import FoldcoreError
-from . import interrupts
+from . import interrupts, result_commands
 from .limits import (CELL_RATIO, GROUND_RATIO, LENGTH_MM, MARGIN_RATIO, MAX_ELASTIC_VERTICES,
                      MAX_ITERATIONS, MAX_MESH_VERTICES, STROKE_RATIO, SUBDIVISIONS,
                      THICKNESS_RATIO, TOLERANCE, WIDTH_RATIO)
@@ -449,66 +449,8 @@ def _why(result) -> str:
             "callback": "stopped"}.get(result.reason, result.reason)
 
 
-def render_result(args) -> int:
-    """Run ``foldcore render``; raises FoldcoreError on bad input. The thick mesh is
-    rebuilt from the file (:func:`foldcore.result_file.read_result`): its stored faces
-    carry no panel/hinge or M/V information. A thin sheet's result is drawn from
-    its triangles (:func:`foldcore.sheet_render.render_sheet_result`)."""
-    from .result_file import SheetResultFile, read_result
-    from .measure import fold_angles
-    from .render import colour_limits, per_strip, render_png, strip_bend_angles
-
-    check_destinations({"-o": args.output}, inputs=(args.result,), suffixes={"-o": (".png",)})
-    res = read_result(args.result, args.hinge_width, args.subdivisions, thin=True)
-    if isinstance(res, SheetResultFile):
-        from .sheet_render import render_sheet_result
-        render_sheet_result(res, args.output, args.size, args.view, args.color_by)
-        return 0
-    options = {}
-    if args.color_by == "strain":   # largest surface tension of each sub-strip
-        from .strain import strains_at
-
-        values = strains_at(res.mesh.groups["bending_hinge"], res.positions).max(axis=1)
-        options = dict(scalars=values, clim=colour_limits(values, signed=False),
-                       cmap="viridis", scalar_name="surface tension strain")
-    elif args.color_by != "none":   # signed angles, valley > 0: blue, mountain < 0: red
-        angle = args.color_by == "angle"
-        values = per_strip(res.mesh, fold_angles(res.pattern, res.mesh, res.positions)) \
-            if angle else strip_bend_angles(res.mesh, res.positions)
-        options = dict(scalars=values, clim=colour_limits(values, signed=True), cmap="RdBu",
-                       scalar_name="fold angle (deg)" if angle else "strip bend (deg)")
-    render_png(res.pattern, res.mesh, res.positions, args.output, size=args.size,
-               view=args.view, **options)
-    return 0
-
-
-def export_result(args) -> int:
-    """Run ``foldcore export``; raises FoldcoreError on bad input."""
-    from .fabrication import ExportError, export
-    from .result_file import read_result
-
-    if not (args.svg or args.dxf or args.stl):
-        raise ExportError(f"{args.result}: nothing to export: give --svg, --dxf and/or --stl")
-    check_destinations({"--svg": args.svg, "--dxf": args.dxf, "--stl": args.stl},
-                       inputs=(args.result,))
-    export(read_result(args.result, args.hinge_width, args.subdivisions),
-           svg=args.svg, dxf=args.dxf, stl=args.stl, stroke_mm=args.stroke_width,
-           margin_mm=args.margin)
-    return 0
-
-
-def view_result(args) -> int:
-    """Run ``foldcore view`` (:mod:`foldcore.view`); raises FoldcoreError on bad input."""
-    from .view import view_html
-
-    check_destinations({"-o": args.output}, inputs=(args.result,),
-                       suffixes={"-o": (".html", ".htm")})
-    view_html(args.result, args.output)
-    return 0
-
-
-COMMANDS = {"simulate": simulate, "render": render_result, "export": export_result,
-            "view": view_result, "scene": run_scene, **study_commands.COMMANDS}
+COMMANDS = {"simulate": simulate, "scene": run_scene, **result_commands.COMMANDS,
+            **study_commands.COMMANDS}
 
 
 def _say_warnings(caught: list) -> None:

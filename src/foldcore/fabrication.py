@@ -23,7 +23,13 @@ hand (exact mm units through ``viewBox``, deterministic output); DXF through
 ezdxf (the ``export`` extra), ``$INSUNITS`` = mm.
 
 Folded solid (3D printing, CAD): binary STL (mm) of the outer surface,
-:func:`foldcore.surface.write_stl`. Result files (``foldcore simulate -o``)
+:func:`foldcore.surface.write_stl`.
+
+A thin sheet's result (:class:`foldcore.result_file.SheetResultFile`) has no
+strips or panels: its flat sheet is its lines (:func:`crease_lines`), each
+edge one open segment — ``CUT`` the boundary edges (both sides of a cut
+drawn once), ``HINGE_M`` / ``HINGE_V`` / ``HINGE_F`` / ``HINGE`` the creases
+— and its STL the folded triangles, a surface without thickness. Result files (``foldcore simulate -o``)
 are read back by :func:`foldcore.result_file.read_result`. Every file is
 written atomically (:mod:`foldcore.files`): it appears complete or not at all.
 Design notes:
@@ -149,8 +155,9 @@ def _drop_collinear(xy, scale: float) -> np.ndarray:
 
 # ------------------------------------------------------------------- SVG
 def svg_text(outlines: dict, title: str = "foldcore flat sheet", stroke_mm: float | None = None,
-             margin_mm: float | None = None) -> str:
-    """An SVG document (mm) of :func:`sheet_outlines`: one ``<g>`` per layer, ``<polygon>``s.
+             margin_mm: float | None = None, closed: bool = True) -> str:
+    """An SVG document (mm) of :func:`sheet_outlines`: one ``<g>`` per layer, ``<polygon>``s
+    (``<polyline>``s of :func:`crease_lines` with ``closed`` False).
 
     SVG's y axis points down, so y is written negated (the sheet is not mirrored).
     ``stroke_mm``/``margin_mm``: stroke width and margin around the sheet, mm
@@ -173,7 +180,7 @@ def svg_text(outlines: dict, title: str = "foldcore flat sheet", stroke_mm: floa
                      f'stroke-width="{_num(stroke)}">')
         for p in loops:
             points = " ".join(f"{_num(x)},{_num(-y)}" for x, y in p)
-            lines.append(f'<polygon points="{points}"/>')
+            lines.append(f'<{"polygon" if closed else "polyline"} points="{points}"/>')
         lines.append("</g>")
     lines.append("</svg>")
     return "\n".join(lines) + "\n"
@@ -196,9 +203,10 @@ def write_svg(path, mesh, pattern=None, stroke_mm: float | None = None,
 
 
 # ------------------------------------------------------------------- DXF
-def dxf_text(outlines: dict) -> str:
-    """A DXF (R2010, mm) of :func:`sheet_outlines`: closed LWPOLYLINEs, one DXF layer per
-    outline layer (CUT, PANEL, HINGE_M, HINGE_V, ...)."""
+def dxf_text(outlines: dict, closed: bool = True) -> str:
+    """A DXF (R2010, mm) of :func:`sheet_outlines`: closed LWPOLYLINEs (open ones of
+    :func:`crease_lines` with ``closed`` False), one DXF layer per outline layer (CUT,
+    PANEL, HINGE_M, HINGE_V, ...)."""
     try:
         import ezdxf
         from ezdxf import units
@@ -211,7 +219,7 @@ def dxf_text(outlines: dict) -> str:
     for layer, loops in outlines.items():
         doc.layers.add(layer, color=LAYERS.get(layer, {}).get("dxf_colour", 7))
         for p in loops:
-            msp.add_lwpolyline([tuple(map(float, q)) for q in p], close=True,
+            msp.add_lwpolyline([tuple(map(float, q)) for q in p], close=closed,
                                dxfattribs={"layer": layer})
     stream = io.StringIO()
     doc.write(stream)
@@ -221,6 +229,55 @@ def dxf_text(outlines: dict) -> str:
 def write_dxf(path, mesh, pattern=None) -> None:
     """Write the flat sheet's outlines as DXF (mm) to ``path`` atomically."""
     _write_text(path, dxf_text(sheet_outlines(mesh, pattern)))
+
+
+# ------------------------------------------------------------------- thin sheets
+def crease_lines(pattern) -> dict:
+    """The flat thin sheet's lines, mm, per layer (module docstring): each a (2, 2)
+    segment; boundary edges on each other (the two sides of a cut) drawn once."""
+    xy = np.asarray(pattern.vertices, dtype=float)
+    out = {}
+    kinds = np.asarray(pattern.assignments)
+    for layer, pick in (("CUT", kinds == "B"), ("HINGE_M", kinds == "M"),
+                        ("HINGE_V", kinds == "V"), ("HINGE_F", kinds == "F"),
+                        ("HINGE", kinds == "U")):
+        segments = xy[pattern.edges[pick]]
+        if len(segments):
+            out[layer] = list(_once(segments))
+    return out
+
+
+def _once(segments: np.ndarray) -> np.ndarray:
+    """``segments`` (S, 2, 2) with each drawn once, whichever way it runs."""
+    forward = np.where((segments[:, 0, 0] < segments[:, 1, 0])[:, None, None]
+                       | ((segments[:, 0, 0] == segments[:, 1, 0])
+                          & (segments[:, 0, 1] <= segments[:, 1, 1]))[:, None, None],
+                       segments, segments[:, ::-1])
+    _, first = np.unique(forward.reshape(-1, 4), axis=0, return_index=True)
+    return segments[np.sort(first)]
+
+
+def export_sheet(result, svg=None, dxf=None, stl=None, stroke_mm: float | None = None,
+                 margin_mm: float | None = None) -> list:
+    """:func:`export` of a thin sheet's result (a
+    :class:`foldcore.result_file.SheetResultFile`): its lines as SVG/DXF, its folded
+    triangles as STL; all written or none."""
+    from .surface import triangles_stl_bytes
+
+    _check_destinations((svg, dxf, stl))
+    limits.check_svg_sizes(stroke_mm, margin_mm, result.pattern.vertices, result.source)
+    lines = crease_lines(result.pattern)
+    contents = []
+    if svg:
+        contents.append((svg, svg_text(lines, f"foldcore thin sheet of {result.source}",
+                                       stroke_mm, margin_mm, closed=False)))
+    if dxf:
+        contents.append((dxf, dxf_text(lines, closed=False)))
+    if stl:
+        positions = result.frames[-1].positions
+        contents.append((stl, triangles_stl_bytes(positions[result.triangles],
+                                                  "foldcore thin sheet (no thickness), mm")))
+    return _write_all(contents)
 
 
 # ------------------------------------------------------------------- all at once
@@ -244,12 +301,8 @@ def export(result: ResultFile, svg=None, dxf=None, stl=None, stroke_mm: float | 
         1e-6 … 1 and 0 … 10 × the sheet's extent (:data:`foldcore.limits.STROKE_RATIO`,
         :data:`foldcore.limits.MARGIN_RATIO`).
     """
-    if not (svg or dxf or stl):
-        raise ExportError("nothing to export: give svg, dxf and/or stl paths")
+    _check_destinations((svg, dxf, stl))
     limits.check_svg_sizes(stroke_mm, margin_mm, result.pattern.vertices, result.source)
-    for path in (svg, dxf, stl):
-        if path:
-            files.check_folder(path, ExportError)  # every destination before any write
     contents = []
     if svg or dxf:
         result.check_footprint()
@@ -261,6 +314,20 @@ def export(result: ResultFile, svg=None, dxf=None, stl=None, stroke_mm: float | 
             contents.append((dxf, dxf_text(outlines)))
     if stl:
         contents.append((stl, stl_bytes(result.mesh, result.positions, source=result.source)))
+    return _write_all(contents)
+
+
+def _check_destinations(paths) -> None:
+    """ExportError when no path is given, or a path's folder cannot be written."""
+    if not any(paths):
+        raise ExportError("nothing to export: give svg, dxf and/or stl paths")
+    for path in paths:
+        if path:
+            files.check_folder(path, ExportError)  # every destination before any write
+
+
+def _write_all(contents: list) -> list:
+    """Write each (path, text or bytes) of ``contents``, all or none; the paths written."""
     with files.all_or_nothing(dict(enumerate(p for p, _ in contents))) as tmp:
         for i, (_, data) in enumerate(contents):
             with open(tmp[i], "xb") as fh:

@@ -101,18 +101,21 @@ def stl_bytes(mesh, positions=None, header: str = "foldcore thick solid, mm",
     if x.shape != (mesh.n_vertices, 3) or not np.isfinite(x).all():
         raise ExportError(f"positions must be a finite ({mesh.n_vertices}, 3) array of mm, "
                           f"got shape {x.shape}")
-    tris = surface_triangles(mesh, source=source)
-    v = x[tris]
+    return triangles_stl_bytes(x[surface_triangles(mesh, source=source)], header)
+
+
+def triangles_stl_bytes(v: np.ndarray, header: str) -> bytes:
+    """Binary STL of triangles ``v`` (T, 3, 3) mm, each facet's normal from its winding."""
     normal = np.cross(v[:, 1] - v[:, 0], v[:, 2] - v[:, 0])
     length = np.linalg.norm(normal, axis=1)
     normal = np.divide(normal, length[:, None], out=np.zeros_like(normal),
                        where=length[:, None] > 0)
-    records = np.zeros(len(tris), dtype=STL_RECORD)
+    records = np.zeros(len(v), dtype=STL_RECORD)
     records["normal"], records["v"] = normal, v
     head = header.encode("ascii", "replace")[:80].ljust(80, b" ")
     if head.lower().startswith(b"solid"):   # binary STL must not look like ASCII STL
         head = b"foldcore " + head[:71]
-    return head + np.uint32(len(tris)).tobytes() + records.tobytes()
+    return head + np.uint32(len(v)).tobytes() + records.tobytes()
 
 
 def write_stl(path, mesh, positions=None, source: str | None = None) -> None:
