@@ -264,8 +264,22 @@ def test_a_rotated_rect_is_read_rotated(tmp_path):
     path = tmp_path / "p.svg"
     path.write_text(svg('<rect x="40" y="40" width="20" height="20" fill="none" '
                         'stroke="#00f" transform="rotate(45 50 50)"/>'))
-    segments, kinds, _, _ = _strokes(str(path))
+    segments, kinds, _, _, _ = _strokes(str(path))
     corners = segments[:, 0] - 50.0
     assert len(segments) == 4 and set(kinds) == {"V"}
     np.testing.assert_allclose(np.abs(corners).max(axis=1), 10 * 2 ** 0.5, rtol=1e-12)
     np.testing.assert_allclose(np.abs(corners).min(axis=1), 0.0, atol=1e-9)
+
+
+def test_vertices_are_numbered_as_origami_simulator_reads_the_drawing(tmp_path):
+    """Origami Simulator reads the border lines first, then mountains, valleys, cuts,
+    facets and free hinges, each kind as paths, lines, rects, polygons, polylines: a
+    valley drawn before the border still numbers its vertices after the border's (the
+    numbering decides the diagonal of a square face)."""
+    body = ('<line x1="50" y1="100" x2="50" y2="0" stroke="#00f"/>'
+            '<polyline points="0,100 0,0" fill="none" stroke="#000"/>'
+            '<line x1="0" y1="0" x2="100" y2="0" stroke="#000"/>'
+            '<path d="M100 0 L100 100 L0 100" fill="none" stroke="#000"/>')
+    pattern, _ = read_text(tmp_path, svg(body))
+    px = np.round(pattern.vertices / MM_PER_PX * [1, -1], 6).tolist()
+    assert px == [[100, 0], [100, 100], [0, 100], [0, 0], [50, 100], [50, 0]]

@@ -40,7 +40,8 @@ RENODING_PASSES = 3
 
 def pattern_from_lines(segments: np.ndarray, kinds, angles, owners, source: str, *,
                        tol: float, factor: float = 1.0, where=None,
-                       sides_as_origami_simulator: bool = False) -> CreasePattern:
+                       sides_as_origami_simulator: bool = False,
+                       numbering=None) -> CreasePattern:
     """The crease pattern of a line drawing (module docstring).
 
     Parameters
@@ -62,8 +63,11 @@ def pattern_from_lines(segments: np.ndarray, kinds, angles, owners, source: str,
         angles drawn over each other, read as Origami Simulator reads them
         (:func:`sides_read_as_origami_simulator`; :data:`OVERLAP_ORDER`) instead
         of refused.
+    numbering : (S,) int, optional
+        The order of the segments whose endpoints number the vertices
+        (:func:`in_drawing_order`; default the file's).
     """
-    vertices, edges, pieces = planarise(segments, tol, source)
+    vertices, edges, pieces = planarise(segments, tol, source, numbering)
     extra = {} if where is None else {"where": where}
     overlaps = Counter() if sides_as_origami_simulator else None
     assignments, fold_angles = piece_types(pieces, edges, vertices, segments, kinds,
@@ -144,10 +148,11 @@ def check_meetings(segments: np.ndarray, source: str) -> None:
 
 
 
-def planarise(segments: np.ndarray, tol: float, source: str = "<segments>"):
+def planarise(segments: np.ndarray, tol: float, source: str = "<segments>", numbering=None):
     """(V, 2) vertices, (E, 2) edges and the (E, 2, 2) noded pieces of the segments:
     endpoints snapped onto nearby segments, near coordinates merged, crossings and
-    overlaps noded (shapely's unary union)."""
+    overlaps noded (shapely's unary union); vertices numbered as the segments in
+    ``numbering``'s order reach them (:func:`in_drawing_order`)."""
     import shapely
 
     from ..planar import crossing_pairs
@@ -158,7 +163,8 @@ def planarise(segments: np.ndarray, tol: float, source: str = "<segments>"):
         if not crossing_pairs(vertices, edges):
             break
         vertices, edges, pieces = _node_and_merge(vertices[edges], tol, source)
-    vertices, edges = in_drawing_order(vertices, edges, segments, tol)
+    order = slice(None) if numbering is None else numbering
+    vertices, edges = in_drawing_order(vertices, edges, segments[order], tol)
     return vertices, edges, pieces
 
 

@@ -77,6 +77,12 @@ STROKES = {(0, 0, 0): ("B", 0.0), (255, 0, 0): ("M", -1.0), (0, 0, 255): ("V", 1
 MAX_COORD_PX = 1e9
 #: Most straight segments in one pattern ...
 MAX_SEGMENTS = 200_000
+#: The order in which Origami Simulator's ``loadSVG`` reads the crease types (its
+#: ``findType`` calls), and within one type the element kinds (``findType``'s parse
+#: calls); its vertices are numbered as they come, which decides the diagonal of a
+#: square face (:func:`foldcore.sheet.build.face_triangles`).
+READ_ORDER = ("B", "M", "V", "C", "F", "U")
+TAG_ORDER = {"path": 0, "line": 1, "rect": 2, "polygon": 3, "polyline": 4}
 #: An SVG number, and one followed by a unit (a length).
 _NUMBER = re.compile(r"([+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)")
 _LENGTH = re.compile(_NUMBER.pattern + r"\s*(?:px|mm|cm|in|pt|pc|em|ex|%)?")
@@ -100,7 +106,7 @@ def read_svg(path, reading: Reading | None = None) -> CreasePattern:
     """
     source = os.fspath(path)
     reading = Reading() if reading is None else reading
-    segments, kinds, angles, owners = _strokes(source)
+    segments, kinds, angles, owners, numbering = _strokes(source)
     if not len(segments):
         raise PatternError(f"{source}: no stroked lines in Origami Simulator's colours "
                            "(red mountain, blue valley, black boundary, yellow facet, "
@@ -112,13 +118,16 @@ def read_svg(path, reading: Reading | None = None) -> CreasePattern:
                               tol=min(SNAP_PX, SNAP_MAX * extent),
                               factor=reading.factor(extent * MM_PER_PX) * MM_PER_PX,
                               where=lambda x, y: f"({x:g}, {-y:g}) px",
-                              sides_as_origami_simulator=True)
+                              sides_as_origami_simulator=True, numbering=numbering)
 
 
 def _strokes(source: str):
-    """(S, 2, 2) straight segments (px), their assignment, target (degrees or NaN) and
-    the element each came from (for messages)."""
+    """(S, 2, 2) straight segments (px), their assignment, target (degrees or NaN), the
+    element each came from (for messages), and the segments in the order Origami
+    Simulator reads them (:data:`READ_ORDER`, then :data:`TAG_ORDER`, then the file's),
+    which numbers the vertices."""
     segments, kinds, angles, owners, ignored, curves = [], [], [], [], {}, []
+    ranks = []
     for number, element in enumerate(_shapes(source)):
         name = _element_name(element, number)
         kind, sign = _stroke_type(element)
@@ -137,6 +146,9 @@ def _strokes(source: str):
             raise PatternError(f"{source}: {name} cannot be computed "
                                f"({_failure(exc)})") from None
         segments += found
+        tag = type(element).__name__.lower().replace("simpleline", "line")
+        ranks += [(READ_ORDER.index(kind), TAG_ORDER.get(tag, len(TAG_ORDER)), number)] \
+            * len(found)
         kinds += [kind] * len(found)
         angles += [angle] * len(found)
         owners += [name] * len(found)
@@ -150,8 +162,9 @@ def _strokes(source: str):
         counts = ", ".join(f"{n} {c}" for c, n in sorted(ignored.items()))
         note(source, f"{sum(ignored.values())} shapes whose stroke is none of Origami "
                      f"Simulator's colours were ignored ({counts})")
+    ranks = np.array(ranks, dtype=np.int64).reshape(-1, 3)
     return (np.array(segments, dtype=np.float64).reshape(-1, 2, 2), np.array(kinds),
-            np.array(angles, dtype=np.float64), owners)
+            np.array(angles, dtype=np.float64), owners, np.lexsort(ranks.T[::-1]))
 
 
 def _shapes(source: str) -> list:
