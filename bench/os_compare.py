@@ -76,7 +76,7 @@ def normalised(xy: np.ndarray) -> np.ndarray:
     return (xy - centre) / np.sqrt(np.max(np.sum((xy - centre) ** 2, axis=1)))
 
 
-def match(pattern, state: dict):
+def match(pattern, state: dict, drawn=None):
     """((the pattern vertex of each node of foldcore's sheet, Origami Simulator's node
     of each), largest gap) or (None, gap): the sheet leaves out straight degree-2
     vertices as Origami Simulator does, so its nodes, not the pattern's vertices,
@@ -86,7 +86,7 @@ def match(pattern, state: dict):
 
     theirs = normalised(state["fold"]["vertices_coords"][:, [0, 2]] * [1.0, -1.0])
     vertices = np.asarray(pattern.vertices, dtype=float)
-    sheet = build_sheet(pattern, merge_straight=True)
+    sheet = build_sheet(pattern, merge_straight=True, drawn=drawn)
     kept = sheet.vertex_ids
     mine = normalised(vertices)[kept]
     k = min(4, len(theirs))
@@ -116,15 +116,17 @@ def fan_directions(points: np.ndarray, triangles) -> np.ndarray:
     return d / np.maximum(np.linalg.norm(d, axis=1), 1e-300)[:, None]
 
 
-def fold(pattern, percent: float, runs: int, drawing: bool = False):
+def fold(pattern, percent: float, runs: int, drawing=None):
     """(SheetFold, median seconds) of ``runs`` folds of ``pattern`` from flat
-    (``drawing``: read from an SVG, built as ``simulate`` builds it)."""
+    (``drawing``: the vertices as drawn of a pattern read from an SVG, built as
+    ``simulate`` builds it)."""
     from foldcore.sheet import SheetSolver, build_sheet
 
     seconds, result = [], None
     for _ in range(runs):
         t0 = time.perf_counter()
-        result = SheetSolver(build_sheet(pattern, merge_straight=drawing), percent,
+        result = SheetSolver(build_sheet(pattern, merge_straight=drawing is not None,
+                                         drawn=drawing), percent,
                              pattern_edges=pattern.n_edges).run()
         seconds.append(time.perf_counter() - t0)
     return result, _meta.median(seconds)
@@ -142,7 +144,7 @@ def difference(state, entry, positions) -> dict:
 
 def one_file(path: Path, svgs: Path, runs: int) -> dict:
     """Every comparison of one state file (module docstring)."""
-    from foldcore.io import read
+    from foldcore.io import read_file
 
     state = osl.load_state(path)
     row = {"svg": state["svg"], "nodes": int(len(state.get("nodes", []))), "folds": []}
@@ -155,15 +157,16 @@ def one_file(path: Path, svgs: Path, runs: int) -> dict:
     except Exception as exc:  # a mesh foldcore's pattern refuses (cut sheets)
         mesh_pattern, row["mesh_error"] = None, f"{type(exc).__name__}: {exc}"[:200]
     try:
-        user_pattern = read(svg)
-        nodes, row["gap"] = match(user_pattern, state)
+        loaded = read_file(svg)
+        user_pattern, drawn = loaded.pattern, loaded.drawing
+        nodes, row["gap"] = match(user_pattern, state, drawn)
     except Exception as exc:  # the reader's refusal, said in one line
-        user_pattern, nodes, row["read_error"] = None, None, str(exc)[len(str(svg)) + 2:][:200]
+        user_pattern, drawn, nodes, row["read_error"] = None, None, None, str(exc)[len(str(svg)) + 2:][:200]
     row["matched"] = nodes is not None
     for entry in state["folds"]:
         if entry.get("positions_b") is None or not entry["settled"]:
             if user_pattern is not None:  # no shape to compare with: foldcore's time alone
-                result, seconds = fold(user_pattern, entry["percent"], 1, drawing=True)
+                result, seconds = fold(user_pattern, entry["percent"], 1, drawing=drawn)
                 row["folds"].append({"percent": entry["percent"], "unsettled_os": {
                     "reason": result.reason, "iterations": result.iterations,
                     "seconds": seconds}})
@@ -176,7 +179,7 @@ def one_file(path: Path, svgs: Path, runs: int) -> dict:
                             "reason": result.reason, "iterations": result.iterations,
                             "seconds": seconds}
         if nodes is not None:
-            result, seconds = fold(user_pattern, entry["percent"], runs, drawing=True)
+            result, seconds = fold(user_pattern, entry["percent"], runs, drawing=drawn)
             kept, theirs = nodes
             positions = np.empty((len(theirs), 3))
             positions[theirs] = to_os_frame(result.positions[kept])

@@ -283,3 +283,26 @@ def test_vertices_are_numbered_as_origami_simulator_reads_the_drawing(tmp_path):
     pattern, _ = read_text(tmp_path, svg(body))
     px = np.round(pattern.vertices / MM_PER_PX * [1, -1], 6).tolist()
     assert px == [[100, 0], [100, 100], [0, 100], [0, 0], [50, 100], [50, 0]]
+
+
+def test_a_square_face_is_cut_along_its_shorter_diagonal_as_drawn(tmp_path):
+    """Origami Simulator compares a quadrilateral's diagonals on the points as drawn;
+    foldcore's reader merges points onto a grid (1 px for a 100 px drawing), where
+    this square's corner drawn at (0.3, 100) becomes (0, 100) and the diagonals
+    tie. The thin sheet cuts it along the diagonal that is shorter as drawn (1–3),
+    not the tie's (through the lowest vertex id, 0–2)."""
+    from foldcore.io import read_file
+    from foldcore.sheet import build_sheet
+
+    path = tmp_path / "p.svg"
+    path.write_text(svg('<polygon points="0,0 100,0 100,100 0.3,100" fill="none" '
+                        'stroke="#000"/>'))
+    loaded = read_file(path)
+    assert np.round(loaded.pattern.vertices / MM_PER_PX, 9).tolist()[3] == [0, -100]
+
+    def diagonal(sheet):
+        (ends,) = sheet.vertex_ids[sheet.hinges[sheet.hinge_edge == -1][:, :2]]
+        return sorted(ends.tolist())
+    assert diagonal(build_sheet(loaded.pattern, merge_straight=True,
+                                drawn=loaded.drawing)) == [1, 3]
+    assert diagonal(build_sheet(loaded.pattern, merge_straight=True)) == [0, 2]

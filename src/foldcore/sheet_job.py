@@ -55,7 +55,8 @@ def run_thin(job, loaded, on_start=None, callback=None):
     warnings.warn(f"{job.source}: {THIN_NOTE}", RunWarning, stacklevel=3)
     s, pattern = job.solving, loaded.pattern
     t0 = time.perf_counter()
-    sheet = build_sheet(pattern, merge_straight=loaded.drawing)
+    drawing = loaded.drawing
+    sheet = build_sheet(pattern, merge_straight=drawing is not None, drawn=drawing)
     if len(sheet.merged):
         count = len(sheet.merged)
         which = "1 vertex" if count == 1 else f"{count} vertices"

@@ -88,7 +88,8 @@ def read_file(path, *, hinges=None, reading: Reading | None = None) -> FoldFile:
         return read_fold_file(source, reading)
     if suffix == ".svg":
         from .svg import read_svg  # svgelements only when an SVG is read
-        return FoldFile(read_svg(source, reading), None, "mm", drawing=True)
+        pattern, drawn = read_svg(source, reading, with_drawn=True)
+        return FoldFile(pattern, None, "mm", drawing=drawn)
     if suffix == ".cp":
         from .cp import read_cp
         return FoldFile(read_cp(source, reading), None, "mm")

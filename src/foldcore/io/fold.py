@@ -93,10 +93,13 @@ class FoldFile:
     hinge : list of str or None, or None
         Hinge model per edge from ``foldcore:edges_hinge`` (None entries:
         the default), ready for ``thicken(..., hinge=...)``; None when absent.
-    drawing : bool
-        Read from an SVG drawing: a thin sheet leaves out its straight degree-2
-        vertices, as Origami Simulator does with a drawing and not with a FOLD
-        file (:func:`foldcore.sheet.build_sheet`'s ``merge_straight``).
+    drawing : (V, 2) float or None
+        Read from an SVG drawing: each vertex as first drawn, mm, before the
+        reader merged close points (None for other files). A thin sheet then
+        reads the drawing as Origami Simulator does: it leaves out the straight
+        degree-2 vertices (as Origami Simulator does with a drawing and not with
+        a FOLD file) and cuts each quadrilateral along its shorter diagonal as
+        drawn (:func:`foldcore.sheet.build_sheet`'s ``merge_straight``, ``drawn``).
     """
 
     pattern: CreasePattern
@@ -104,7 +107,7 @@ class FoldFile:
     frame_unit: str
     stiffness: dict | None = None
     hinge: list | None = None
-    drawing: bool = False
+    drawing: np.ndarray | None = None
 
 
 # ------------------------------------------------------------------- reading

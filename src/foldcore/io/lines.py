@@ -41,7 +41,7 @@ RENODING_PASSES = 3
 def pattern_from_lines(segments: np.ndarray, kinds, angles, owners, source: str, *,
                        tol: float, factor: float = 1.0, where=None,
                        sides_as_origami_simulator: bool = False,
-                       numbering=None) -> CreasePattern:
+                       numbering=None, with_drawn: bool = False):
     """The crease pattern of a line drawing (module docstring).
 
     Parameters
@@ -66,8 +66,16 @@ def pattern_from_lines(segments: np.ndarray, kinds, angles, owners, source: str,
     numbering : (S,) int, optional
         The order of the segments whose endpoints number the vertices
         (:func:`in_drawing_order`; default the file's).
+    with_drawn : bool
+        Return (pattern, drawn) instead: ``drawn`` (V, 2) mm, each vertex of the
+        pattern as first drawn, before merging (copies along a cut as their
+        vertex), which Origami Simulator's reading keeps.
+
+    Returns
+    -------
+    CreasePattern, or (CreasePattern, (V, 2) float) with ``with_drawn``
     """
-    vertices, edges, pieces = planarise(segments, tol, source, numbering)
+    vertices, edges, pieces, drawn = planarise(segments, tol, source, numbering)
     extra = {} if where is None else {"where": where}
     overlaps = Counter() if sides_as_origami_simulator else None
     assignments, fold_angles = piece_types(pieces, edges, vertices, segments, kinds,
@@ -79,15 +87,20 @@ def pattern_from_lines(segments: np.ndarray, kinds, angles, owners, source: str,
                      f"({' '.join(OVERLAP_ORDER)}, then file order): "
                      + ", ".join(f"{k} over {v}" for (k, v) in sorted(overlaps)))
     if sides_as_origami_simulator:
-        vertices, edges, assignments, fold_angles = sides_read_as_origami_simulator(
+        used, edges, assignments, fold_angles = sides_read_as_origami_simulator(
             vertices, edges, assignments, fold_angles, source)
-    return CreasePattern(vertices * factor, edges, assignments, fold_angles=fold_angles,
-                         source=source)
+        vertices, drawn = vertices[used], drawn[used]
+    pattern = CreasePattern(vertices * factor, edges, assignments, fold_angles=fold_angles,
+                            source=source)
+    if not with_drawn:
+        return pattern
+    drawn = drawn * factor
+    return pattern, np.concatenate([drawn, drawn[pattern.copied_from]])
 
 
 def sides_read_as_origami_simulator(vertices, edges, assignments, fold_angles, source: str):
-    """(vertices, edges, assignments, fold_angles) with the lines whose type contradicts
-    their sides read as Origami Simulator reads them, each kind said once with a
+    """(kept vertex ids, edges, assignments, fold_angles) with the lines whose type
+    contradicts their sides read as Origami Simulator reads them, each kind said once with a
     count: a crease (M, V, F, U) with the sheet on one side only is boundary (B: no
     face to fold against), a boundary line (B) with the sheet on both sides is a free
     hinge (U: a bar without a spring). Lines with the sheet on neither side (drawn
@@ -122,10 +135,9 @@ def sides_read_as_origami_simulator(vertices, edges, assignments, fold_angles, s
                      "folds them")
         assignments[inner], fold_angles[inner] = "U", np.nan
     if not outside.any():
-        return vertices, edges, assignments, fold_angles
+        return np.arange(len(vertices)), edges, assignments, fold_angles
     used, ends = np.unique(edges[~outside], return_inverse=True)
-    return (vertices[used], ends.reshape(-1, 2), assignments[~outside],
-            fold_angles[~outside])
+    return used, ends.reshape(-1, 2), assignments[~outside], fold_angles[~outside]
 
 
 def check_meetings(segments: np.ndarray, source: str) -> None:
@@ -149,14 +161,16 @@ def check_meetings(segments: np.ndarray, source: str) -> None:
 
 
 def planarise(segments: np.ndarray, tol: float, source: str = "<segments>", numbering=None):
-    """(V, 2) vertices, (E, 2) edges and the (E, 2, 2) noded pieces of the segments:
-    endpoints snapped onto nearby segments, near coordinates merged, crossings and
-    overlaps noded (shapely's unary union); vertices numbered as the segments in
-    ``numbering``'s order reach them (:func:`in_drawing_order`)."""
+    """(V, 2) vertices, (E, 2) edges, the (E, 2, 2) noded pieces of the segments and
+    the (V, 2) vertices as drawn: endpoints snapped onto nearby segments, near
+    coordinates merged, crossings and overlaps noded (shapely's unary union);
+    vertices numbered as the segments in ``numbering``'s order reach them
+    (:func:`in_drawing_order`)."""
     import shapely
 
     from ..planar import crossing_pairs
 
+    drawn = segments
     segments = _snap_endpoints(segments, tol)
     vertices, edges, pieces = _node_and_merge(segments, tol, source)
     for _ in range(RENODING_PASSES):  # a merge moved a vertex across an edge: node again
@@ -164,8 +178,9 @@ def planarise(segments: np.ndarray, tol: float, source: str = "<segments>", numb
             break
         vertices, edges, pieces = _node_and_merge(vertices[edges], tol, source)
     order = slice(None) if numbering is None else numbering
-    vertices, edges = in_drawing_order(vertices, edges, segments[order], tol)
-    return vertices, edges, pieces
+    vertices, edges, drawn = in_drawing_order(vertices, edges, segments[order], tol,
+                                              drawn[order])
+    return vertices, edges, pieces, drawn
 
 
 def _node_and_merge(segments: np.ndarray, tol: float, source: str):
@@ -189,11 +204,16 @@ def _node_and_merge(segments: np.ndarray, tol: float, source: str):
 
 
 def in_drawing_order(vertices: np.ndarray, edges: np.ndarray, segments: np.ndarray,
-                     tol: float):
-    """(vertices, edges) renumbered in the order the drawing first reaches each vertex
-    (the segments' endpoints in file order; crossings after them, as they were), as
-    Origami Simulator numbers them: the diagonal a thin sheet cuts a square along
-    follows the numbering (:func:`foldcore.sheet.build.face_triangles`)."""
+                     tol: float, drawn: np.ndarray | None = None):
+    """(vertices, edges, drawn) renumbered in the order the drawing first reaches each
+    vertex (the segments' endpoints in their order; crossings after them, as they
+    were), as Origami Simulator numbers them: the diagonal a thin sheet cuts a square
+    along follows the numbering (:func:`foldcore.sheet.build.face_triangles`).
+    ``drawn`` (V, 2): the endpoint that last reaches each vertex as drawn (in the
+    given ``drawn`` segments, (S, 2, 2), before snapping: default ``segments``), before
+    merging — the point Origami Simulator keeps of a cluster (its
+    ``collapseNearbyVertices`` numbers a cluster by its first point and keeps the
+    coordinates of its last) — or the vertex itself."""
     from scipy.spatial import cKDTree
 
     distance, nearest = cKDTree(vertices).query(segments.reshape(-1, 2))
@@ -203,7 +223,11 @@ def in_drawing_order(vertices: np.ndarray, edges: np.ndarray, segments: np.ndarr
     order = np.lexsort((np.arange(len(vertices)), first))
     new_id = np.empty(len(vertices), dtype=np.int64)
     new_id[order] = np.arange(len(vertices))
-    return vertices[order], new_id[edges]
+    ends = (segments if drawn is None else drawn).reshape(-1, 2)
+    last = np.full(len(vertices), -1, dtype=np.int64)
+    np.maximum.at(last, nearest[reached], np.flatnonzero(reached))
+    drawn = np.where((last >= 0)[:, None], ends[last], vertices)
+    return vertices[order], new_id[edges], drawn[order]
 
 
 def _merge_close(points: np.ndarray, tol: float, source: str):

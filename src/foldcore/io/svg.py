@@ -95,8 +95,10 @@ _SVG_FAILURES = (ArithmeticError, ValueError, TypeError, IndexError, AttributeEr
                  KeyError)
 
 
-def read_svg(path, reading: Reading | None = None) -> CreasePattern:
-    """Read an SVG crease pattern (module docstring); lengths mm, angles degrees.
+def read_svg(path, reading: Reading | None = None, with_drawn: bool = False):
+    """Read an SVG crease pattern (module docstring); lengths mm, angles degrees; with
+    ``with_drawn``, (pattern, its vertices as drawn, (V, 2) mm:
+    :func:`.lines.pattern_from_lines`).
 
     Raises
     ------
@@ -118,7 +120,8 @@ def read_svg(path, reading: Reading | None = None) -> CreasePattern:
                               tol=min(SNAP_PX, SNAP_MAX * extent),
                               factor=reading.factor(extent * MM_PER_PX) * MM_PER_PX,
                               where=lambda x, y: f"({x:g}, {-y:g}) px",
-                              sides_as_origami_simulator=True, numbering=numbering)
+                              sides_as_origami_simulator=True, numbering=numbering,
+                              with_drawn=with_drawn)
 
 
 def _strokes(source: str):

@@ -13,8 +13,9 @@ the folded sheet such a vertex lies on its merged edge where it lay in the flat
 one (the same share of its length).
 
 Each face is cut into triangles as Origami Simulator cuts it (a quadrilateral
-along its shorter diagonal, or on a tie the one through its lowest vertex id,
-which is the one Origami Simulator's face order picks; a larger face by earcut);
+along its shorter diagonal — shorter as drawn, for a drawing whose points the
+reader merged — or on a tie the one through its lowest vertex id, which is the
+one Origami Simulator's face order picks; a larger face by earcut);
 the new diagonals are facet creases, held flat. Every edge is a bar; every
 edge between two triangles is a hinge: a crease spring where the pattern
 gives the crease a target (``M``, ``V`` or ``F``), a facet spring on a
@@ -123,13 +124,16 @@ class Sheet:
         return self.vertex_ids[self.triangles]
 
 
-def face_triangles(xy: np.ndarray, loop: np.ndarray, face: int) -> np.ndarray:
+def face_triangles(xy: np.ndarray, loop: np.ndarray, face: int,
+                   drawn: np.ndarray | None = None) -> np.ndarray:
     """(T, 3) vertex ids of face ``loop`` cut as Origami Simulator cuts it (n − 2
-    triangles; a loop along a slit first cut in two, :func:`slit_free_loops`)."""
+    triangles; a loop along a slit first cut in two, :func:`slit_free_loops`); a
+    quadrilateral's diagonals compared on ``drawn`` (V, 2) when given (the vertices
+    as drawn, :attr:`foldcore.io.FoldFile.drawing`), else on ``xy``."""
     if len(loop) == 3:
         return loop[None, :].copy()
     if len(loop) == 4:
-        p = xy[loop]
+        p = (xy if drawn is None else drawn)[loop]
         across_02, across_13 = np.sum((p[0] - p[2]) ** 2), np.sum((p[1] - p[3]) ** 2)
         if abs(across_02 - across_13) <= TIE * max(across_02, across_13):
             use_13 = int(np.argmin(loop)) % 2 == 1  # a tie: the diagonal through the lowest id
@@ -260,10 +264,12 @@ def _chord_meets(xy, ends, live, a: int, b: int) -> bool:
 
 
 def build_sheet(pattern: CreasePattern, stiffness: Stiffness = Stiffness(),
-                merge_straight: bool = False) -> Sheet:
+                merge_straight: bool = False, drawn: np.ndarray | None = None) -> Sheet:
     """The bar-and-hinge :class:`Sheet` of ``pattern`` (module docstring); with
     ``merge_straight``, straight degree-2 vertices left out as Origami Simulator
-    leaves them out of a drawing."""
+    leaves them out of a drawing; with ``drawn`` ((V, 2) mm, the vertices as
+    drawn, before a reader merged close points), each quadrilateral cut along the
+    diagonal that is shorter as drawn, as Origami Simulator cuts it."""
     xy = np.asarray(pattern.vertices, dtype=float)
     lo, hi = xy.min(axis=0), xy.max(axis=0)
     centre = 0.5 * (lo + hi)
@@ -275,7 +281,7 @@ def build_sheet(pattern: CreasePattern, stiffness: Stiffness = Stiffness(),
     node = np.cumsum(kept) - 1  # pattern vertex → node (for kept vertices)
     flat = np.zeros((len(vertex_ids), 3))
     flat[:, :2] = (xy[vertex_ids] - centre) / radius
-    cut = [node[face_triangles(xy, loop[kept[loop]], f)]
+    cut = [node[face_triangles(xy, loop[kept[loop]], f, drawn)]
            for f, loop in enumerate(map(np.asarray, pattern.faces))]
     triangles = np.concatenate(cut)
     triangle_face = np.repeat(np.arange(len(cut)), [len(t) for t in cut])
