@@ -128,12 +128,66 @@ def test_a_folded_key_frame_reads_the_crease_pattern_frame_of_its_file_frames(in
     assert [m for m in said if "file_frames[1] (frame_classes: creasePattern)" in m]
 
 
-def test_a_folded_form_without_flat_coordinates_is_refused_saying_what_would_do():
+def _edge_lengths_3d(d: dict, pattern) -> np.ndarray:
+    xyz = np.array(d["vertices_coords"], dtype=float)
+    xyz = np.column_stack([xyz, np.zeros(len(xyz))]) if xyz.shape[1] == 2 else xyz
+    return np.linalg.norm(xyz[pattern.edges[:, 0]] - xyz[pattern.edges[:, 1]], axis=1)
+
+
+@pytest.mark.parametrize("name", ["simple.fold", "squaretwist.fold"])
+def test_a_folded_form_without_flat_coordinates_is_unfolded_from_its_faces(name):
+    """3D folded forms (the FOLD spec's example, a square twist): every edge keeps its
+    length (to the file's digits), the faces lie flat without overlapping (the
+    pattern's checks), and the sheet's area is the faces' area in 3D; said once."""
+    d = json.load(open(f"tests/data/real/{name}"))
+    pattern, said = read_said(d)
+    extent = float(np.ptp(pattern.vertices, axis=0).max())
+    assert np.abs(_edge_lengths_3d(d, pattern) - pattern.edge_lengths()).max() < 1e-5 * extent
+    xyz = np.array(d["vertices_coords"], dtype=float)
+    area_3d = sum(0.5 * np.linalg.norm(np.cross(xyz[f], np.roll(xyz[f], -1, axis=0)).sum(0))
+                  for f in map(np.array, d["faces_vertices"]))
+    assert pattern.area() == pytest.approx(area_3d, rel=1e-5)
+    assert [m for m in said if "unfolded from its faces" in m]
+
+
+def test_a_flat_folded_form_unfolds_to_its_crease_pattern():
+    """The diagonal fold folded flat (2D, its two triangles on each other), without its
+    flat coordinates: the second triangle is laid beside the first, mirrored."""
+    cp = json.load(open("tests/data/real/diagonal-cp.fold"))
+    folded = json.load(open("tests/data/real/diagonal-folded.fold"))
+    del folded["vertices_flatUnfoldCoords"]
+    flat, _ = read_said(cp)
+    pattern, _ = read_said(folded)
+    assert pattern.area() == pytest.approx(flat.area())
+    distances = lambda p: np.linalg.norm(p.vertices[:, None] - p.vertices[None], axis=2)  # noqa
+    np.testing.assert_allclose(distances(pattern), distances(flat), atol=1e-12)
+
+
+def test_a_folded_form_its_faces_cannot_flatten_is_refused_naming_what():
+    """A square pyramid's four sides (their corners' angles sum to less than 360°) land
+    their last corner at two places; a bent quadrilateral is not flat; with no faces
+    a folded form says which keys would do."""
+    apex = [[0.5, 0.5, 0.5]]
+    base = [[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0]]
+    pyramid = {"vertices_coords": base + apex, "faces_vertices": [[0, 1, 4], [1, 2, 4],
+                                                                  [2, 3, 4], [3, 0, 4]],
+               "edges_vertices": [[0, 1], [1, 2], [2, 3], [3, 0], [0, 4], [1, 4], [2, 4],
+                                  [3, 4]],
+               "edges_assignment": ["B"] * 4 + ["M"] * 4}
+    with pytest.raises(PatternError, match=r"f\.fold: vertex \d unfolds to two places"):
+        read_said(pyramid)
+    bent = {**pyramid, "vertices_coords": base[:2] + [[1, 1, 0.3], [0, 1, 0]] + apex,
+            "faces_vertices": [[0, 1, 2, 3]], "edges_vertices": pyramid["edges_vertices"][:4],
+            "edges_assignment": ["B"] * 4}
+    bent["vertices_coords"] = bent["vertices_coords"][:4]
+    with pytest.raises(PatternError, match=r"face 0 is not flat"):
+        read_said(bent)
+    simple = json.load(open("tests/data/real/simple.fold"))
+    del simple["faces_vertices"]
     with pytest.raises(PatternError) as info:
-        read_said(json.load(open("tests/data/real/simple.fold")))
-    message = str(info.value)
-    assert "f.fold" in message and "not on one plane" in message
-    assert "vertices_flatUnfoldCoords" in message
+        read_said(simple)
+    assert "not on one plane" in str(info.value)
+    assert "vertices_flatUnfoldCoords" in str(info.value)
 
 
 def test_scale_and_sheet_size_scale_every_length():

@@ -18,7 +18,8 @@ al. 2018), so foldcore reads them as it does (its ``js/importer.js`` and
   side — the side valleys fold towards — stays on top.
 * **A folded form** (``frame_classes`` ``foldedForm``, or coordinates off a
   plane) is read through its ``vertices_flatUnfoldCoords``; without them it is
-  refused with a message saying which keys would do. A key frame labelled a
+  unfolded from its faces (:mod:`.unfold`), or refused with a message saying
+  which keys would do. A key frame labelled a
   folded form whose ``file_frames`` hold a frame labelled ``creasePattern``
   (Rabbit Ear's files) is read from that frame (:func:`crease_pattern_frame`).
 * **Lengths**: ``frame_unit`` as before (a unit-square file is 1 mm wide);
@@ -152,6 +153,15 @@ def trust_signs(angles: list, assignments, source: str) -> list:
         note(source, f"{flipped} fold angles took their assignment's sign "
                      "(reading.trust_assignment=True)")
     return out
+
+
+def on_one_plane(xyz: np.ndarray) -> bool:
+    """Whether the points (V, 3) lie on one plane (within :data:`PLANE_TOLERANCE` of
+    their extent)."""
+    centre = xyz.mean(axis=0)
+    _, _, rows = np.linalg.svd(xyz - centre, full_matrices=False)
+    extent = float(np.ptp(xyz, axis=0).max())
+    return float(np.abs((xyz - centre) @ rows[2]).max()) <= PLANE_TOLERANCE * extent
 
 
 def into_plane(xyz: np.ndarray, faces, source: str) -> np.ndarray:

@@ -63,7 +63,7 @@ from ..hinges import HINGE_MODELS
 from ..pattern import DEFAULT_MAX_ANGLE_DEG, CreasePattern
 from ..planar import Loops, derive_face_loops, freeze, has_repeats, loop_starts, next_in_loop
 from .conventions import (Reading, assigned_angles, crease_pattern_frame, into_plane, note,
-                          trust_signs)
+                          on_one_plane, trust_signs)
 from .fold_json import (ARRAY, CELLS_KEY, EDGE_STIFFNESS_KEY,  # noqa: F401  (part of this API)
                         FACE_STIFFNESS_KEY, HINGE_KEY, MAX_ANGLE_KEY, POISSON_KEY, TARGET_KEY,
                         THICKNESS_KEY, UNIT_MM, WIDTH_KEY, check_length, fail, has_class, index,
@@ -180,9 +180,9 @@ def _fold_file(d, source: str, reading: Reading | None, owned: bool) -> FoldFile
         fail(source, f"the top level must be a JSON object, got {type(d).__name__}")
     d = crease_pattern_frame(d, source)
     unit, scale = _unit_scale(d, source)
-    rows = _crease_pattern_coords(d, source)
+    rows, folded = _crease_pattern_coords(d, source)
     faces = _faces(d, len(rows), source)
-    vertices = _coords(rows, scale, source, faces)
+    vertices = _coords(rows, scale, source, faces, folded)
     del rows
     factor = reading.factor(_extent(vertices))
     if factor != 1.0:
@@ -248,20 +248,17 @@ def _unit_scale(d: dict, source: str) -> tuple[str, float]:
     return unit, UNIT_MM[unit]
 
 
-def _crease_pattern_coords(d: dict, source: str) -> list:
+def _crease_pattern_coords(d: dict, source: str) -> tuple[list, bool]:
     """The rows of the crease pattern's coordinates: ``vertices_coords``, or a folded
-    form's ``vertices_flatUnfoldCoords`` (said)."""
+    form's ``vertices_flatUnfoldCoords`` (said); and whether they are a folded form
+    (labelled so, without flat coordinates: unfolded from its faces, :mod:`.unfold`)."""
     classes = d.get("frame_classes")
     folded = has_class(classes, "foldedForm")
     if d.get("vertices_flatUnfoldCoords") is not None and folded:
         rows = required_list(d, "vertices_flatUnfoldCoords", source)
         note(source, "a folded form: its crease pattern read from vertices_flatUnfoldCoords")
-        return rows
-    if folded:  # Origami Simulator labels its flat exports so: flat is read as the pattern
-        note(source, "labelled a folded form (frame_classes: foldedForm) without "
-                     "vertices_flatUnfoldCoords: its coordinates are read as the crease "
-                     "pattern, which must be flat and without overlaps")
-    return required_list(d, "vertices_coords", source)
+        return rows, False
+    return required_list(d, "vertices_coords", source), folded
 
 
 def _extent(vertices) -> float:
@@ -282,22 +279,40 @@ def _fold_angles(d: dict, assignments, source: str, reading: Reading,
     return assigned_angles(assignments, source, reading, max_angles)
 
 
-def _coords(rows: list, scale: float, source: str, faces=None):
+def _coords(rows: list, scale: float, source: str, faces=None, folded: bool = False):
     """(V, 2) vertex coordinates in mm (``[]`` for none), checked at once when the rows
     are plain [x, y] or [x, y, z] lists; from the first suspect row on, row by row. A
-    sheet in 3D off the z = 0 plane is rotated into it (:func:`.conventions.into_plane`)."""
+    sheet in 3D off the z = 0 plane is rotated into it (:func:`.conventions.into_plane`);
+    a folded form (3D off any plane, or labelled ``folded``) is unfolded from its faces
+    (:func:`.unfold.unfold_faces`)."""
     xy = number_table(rows, (2, 3))
     if xy is None:
         return _coords_by_row(rows, scale, source, 0)
     with np.errstate(over="ignore", invalid="ignore"):
         mm = xy[:, :2] * scale
     bad = ~np.isfinite(xy).all(axis=1) | ~np.isfinite(mm).all(axis=1)
-    if xy.shape[1] == 3 and not bad.any() and (xy[:, 2] != 0).any():
+    in_3d = xy.shape[1] == 3 and not bad.any() and (xy[:, 2] != 0).any()
+    if in_3d and not (faces and not on_one_plane(xy)):
+        if folded:  # Origami Simulator labels its flat exports so
+            note(source, "labelled a folded form (frame_classes: foldedForm) without "
+                         "vertices_flatUnfoldCoords, on one plane: read as the crease pattern")
         return into_plane(xy * scale, faces, source)
+    if (in_3d or folded and not bad.any()) and faces:
+        return _unfolded(xy * scale, faces, source)
     if not bad.any():
         return mm
     first = int(np.argmax(bad))
     return np.concatenate([mm[:first], _coords_by_row(rows, scale, source, first)])
+
+
+def _unfolded(xyz: np.ndarray, faces, source: str) -> np.ndarray:
+    """:func:`.unfold.unfold_faces`, said once."""
+    from .unfold import unfold_faces
+
+    flat = unfold_faces(xyz, faces, source)
+    note(source, "a folded form without vertices_flatUnfoldCoords: its crease pattern "
+                 "unfolded from its faces, each laid flat beside the one before it")
+    return flat
 
 
 def _coords_by_row(rows, scale: float, source: str, start: int):
