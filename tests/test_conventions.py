@@ -221,3 +221,16 @@ def test_achieved_angles_keep_the_assignments_sign_past_flat():
     measured = np.array([179.46, -179.41, 179.46, -30.0, 30.0])
     np.testing.assert_allclose(on_assigned_side(measured, kinds),
                                [-180.54, 180.59, 179.46, -30.0, 30.0])
+
+
+def test_a_2d_folded_form_without_faces_is_read_as_drawn_and_says_so():
+    folded = json.load(open("tests/data/real/diagonal-folded.fold"))
+    del folded["vertices_flatUnfoldCoords"], folded["faces_vertices"]
+    with pytest.raises(PatternError):   # its two layers lie on each other
+        read_said(folded)
+    flat = json.load(open("tests/data/real/diagonal-cp.fold"))
+    flat["frame_classes"] = ["foldedForm"]
+    del flat["faces_vertices"]
+    pattern, said = read_said(flat)
+    assert pattern.area() == pytest.approx(1.0)
+    assert [m for m in said if "without vertices_flatUnfoldCoords or faces" in m]

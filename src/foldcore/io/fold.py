@@ -299,6 +299,10 @@ def _coords(rows: list, scale: float, source: str, faces=None, folded: bool = Fa
         return into_plane(xy * scale, faces, source)
     if (in_3d or folded and not bad.any()) and faces:
         return _unfolded(xy * scale, faces, source)
+    if folded:
+        note(source, "labelled a folded form (frame_classes: foldedForm) without "
+                     "vertices_flatUnfoldCoords or faces to unfold: its coordinates are read "
+                     "as the crease pattern, which must be flat and without overlaps")
     if not bad.any():
         return mm
     first = int(np.argmax(bad))
