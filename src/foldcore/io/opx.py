@@ -17,7 +17,6 @@ lines are refused.
 from __future__ import annotations
 
 import os
-import xml.etree.ElementTree as ET
 
 from ..errors import PatternError
 from ..pattern import CreasePattern
@@ -46,20 +45,11 @@ def read_opx(path, reading: Reading | None = None) -> CreasePattern:
 
 def _root(source: str):
     """The parsed ``<java>`` root element of the file."""
-    import defusedxml
-    from defusedxml.ElementTree import XMLParser
-
     from .fold import read_bytes
+    from .svg_screen import hardened_xml
 
-    parser = XMLParser(forbid_dtd=True, forbid_entities=True, forbid_external=True)
-    try:
-        parser.feed(read_bytes(source))
-        root = parser.close()
-    except ET.ParseError as exc:
-        raise PatternError(f"{source}: not well-formed XML ({exc})") from None
-    except defusedxml.DefusedXmlException as exc:
-        raise PatternError(f"{source}: refused XML construct ({exc}); an ORIPA file needs "
-                           "no entities or DTD") from None
+    root = hardened_xml(read_bytes(source), source, forbid_dtd=True,
+                        needs="an ORIPA file needs no entities or DTD")
     if root.tag != "java":
         raise PatternError(f"{source}: the root element is <{root.tag}>, not <java> "
                            "(ORIPA's .opx is Java's XMLEncoder output)")

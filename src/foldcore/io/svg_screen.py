@@ -6,7 +6,8 @@ DTD tricks refused) and written back without its comments, processing instructio
 and document type: the SVG reader (svgelements) then sees only elements and their
 attributes, in time linear in the file's size. The bounds sit far above Origami
 Simulator's library (84 patterns: at most 0.7 MB, 5 011 elements, nested 7
-deep): a file past them is refused in one line before any work.
+deep): a file past them is refused in one line before any work. The defused
+parse itself (:func:`hardened_xml`) serves ORIPA's ``.opx`` reader too.
 """
 from __future__ import annotations
 
@@ -36,26 +37,32 @@ def screened_svg(path) -> bytes:
         than :data:`MAX_DEPTH` or more than :data:`MAX_ELEMENTS` elements; the
         message names the file (and the line where the parser stopped).
     """
-    import defusedxml
-    from defusedxml.ElementTree import XMLParser
-
     source = str(path)
-    data = read_bytes(path, MAX_SVG_BYTES)
-    parser = XMLParser(forbid_dtd=False, forbid_entities=True, forbid_external=True)
-    try:
-        parser.feed(data)
-        root = parser.close()
-    except ET.ParseError as exc:
-        raise PatternError(f"{source}: not well-formed XML ({exc})") from None
-    except defusedxml.DefusedXmlException as exc:
-        raise PatternError(f"{source}: refused XML construct ({exc}); an SVG crease "
-                           "pattern needs no entities") from None
+    root = hardened_xml(read_bytes(path, MAX_SVG_BYTES), source, forbid_dtd=False,
+                        needs="an SVG crease pattern needs no entities")
     if _local_name(root.tag) != "svg":
         raise PatternError(f"{source}: the root element is <{_local_name(root.tag)}>, "
                            "not <svg>")
     _check_tree(root, source)
     return ET.tostring(root, encoding="utf-8")  # names as written (ASCII would
     #                                               turn À in a name into &#192;)
+
+
+def hardened_xml(data: bytes, source: str, forbid_dtd: bool, needs: str):
+    """The root element of ``data`` parsed with defusedxml: entity declarations and
+    external references refused, and a DTD too with ``forbid_dtd``; PatternError
+    naming ``source`` otherwise (``needs``: what the file's kind does without)."""
+    import defusedxml
+    from defusedxml.ElementTree import XMLParser
+
+    parser = XMLParser(forbid_dtd=forbid_dtd, forbid_entities=True, forbid_external=True)
+    try:
+        parser.feed(data)
+        return parser.close()
+    except ET.ParseError as exc:
+        raise PatternError(f"{source}: not well-formed XML ({exc})") from None
+    except defusedxml.DefusedXmlException as exc:
+        raise PatternError(f"{source}: refused XML construct ({exc}); {needs}") from None
 
 
 def _check_tree(root, source: str) -> None:
