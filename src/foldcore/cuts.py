@@ -53,7 +53,7 @@ class Split:
 
 
 def split_along_cuts(vertices: np.ndarray, edges: np.ndarray, flat: np.ndarray,
-                     lengths: np.ndarray, edge_faces: np.ndarray, cut: np.ndarray) -> Split:
+                     lengths: np.ndarray, slots: np.ndarray, cut: np.ndarray) -> Split:
     """The :class:`Split` of a pattern along the edges where ``cut`` is True.
 
     Parameters
@@ -61,12 +61,13 @@ def split_along_cuts(vertices: np.ndarray, edges: np.ndarray, flat: np.ndarray,
     vertices : (V, 2) float, mm
     edges : (E, 2) int
     flat, lengths : the face loops (counter-clockwise), concatenated, and their lengths
-    edge_faces : (E, 2) int, face left / right of each edge (u → v), −1 if none;
-        every cut has both
+    slots : (N,) int, the edge along each corner's side, + E on the edge's right
+        (:attr:`foldcore.pattern.CreasePattern.side_slots`); every cut has both sides
     cut : (E,) bool
     """
-    side_end, left_corner, right_corner = _sides(edges, flat, lengths)
-    linked = (edge_faces >= 0).all(axis=1) & ~cut
+    side_end = next_in_loop(loop_starts(lengths), lengths)
+    left_corner, right_corner = _side_corners(slots, len(edges))
+    linked = (left_corner >= 0) & (right_corner >= 0) & ~cut
     # across a linked edge u → v: the left face's corner at u with the right face's
     # corner at u (where the right side v → u ends), and likewise at v
     left, right = left_corner[linked], right_corner[linked]
@@ -91,24 +92,14 @@ def split_along_cuts(vertices: np.ndarray, edges: np.ndarray, flat: np.ndarray,
                  cuts[~same], shut)
 
 
-def _sides(edges, flat, lengths):
-    """The corner where each corner's side (to the next corner) ends; per edge, the
-    corner where its left side (u → v) starts and where its right side (v → u)
-    starts (−1 where there is no such side)."""
-    n = int(max(edges.max(), flat.max())) + 1
-    side_end = next_in_loop(loop_starts(lengths), lengths)
-    key = flat * n + flat[side_end]
-    order = np.argsort(key)
-    left_corner = _lookup(key, order, edges[:, 0] * n + edges[:, 1])
-    right_corner = _lookup(key, order, edges[:, 1] * n + edges[:, 0])
-    return side_end, left_corner, right_corner
-
-
-def _lookup(key, order, wanted):
-    """The index in ``key`` of each ``wanted`` value, −1 where absent."""
-    at = np.minimum(np.searchsorted(key[order], wanted), len(key) - 1)
-    found = key[order[at]] == wanted
-    return np.where(found, order[at], -1)
+def _side_corners(slots: np.ndarray, n_edges: int):
+    """Per edge, the corner where its left side (u → v) starts and where its right side
+    (v → u) starts (−1 where there is no such side)."""
+    left, right = np.full(n_edges, -1, dtype=np.int64), np.full(n_edges, -1, dtype=np.int64)
+    on_left = slots < n_edges
+    left[slots[on_left]] = np.flatnonzero(on_left)
+    right[slots[~on_left] - n_edges] = np.flatnonzero(~on_left)
+    return left, right
 
 
 def _components(n: int, a: np.ndarray, b: np.ndarray) -> np.ndarray:

@@ -133,6 +133,13 @@ class CreasePattern:
         """(E,) bool: edges with a target fold angle (``F`` edges count, at 0°)."""
         return ~np.isnan(self.fold_angles) | (self.assignments == "F")
 
+    @property
+    def side_slots(self) -> np.ndarray:
+        """(N,) int: the edge along each face side (the side from each corner of
+        :attr:`face_loops` to the next): ``e`` where the face is on edge e's left
+        (the side runs u → v), ``e + E`` where it is on its right."""
+        return self._side_slots
+
     def edge_lengths(self) -> np.ndarray:
         """(E,) float: edge lengths in mm."""
         d = self.vertices[self.edges[:, 1]] - self.vertices[self.edges[:, 0]]
@@ -162,7 +169,8 @@ class CreasePattern:
         from .cuts import cut_note, split_along_cuts
 
         cut = self.assignments == "C"
-        split = split_along_cuts(self.vertices, self.edges, flat, lengths, self.edge_faces, cut)
+        split = split_along_cuts(self.vertices, self.edges, flat, lengths, self._side_slots,
+                                 cut)
         twice = np.concatenate([np.arange(self.n_edges), split.second_side_of])
         assignments = np.where(cut, np.where(split.shut, "U", "B"), self.assignments)[twice]
         fold_angles = np.where(cut, np.nan, self.fold_angles)[twice]
@@ -363,6 +371,7 @@ class CreasePattern:
                        "same side (overlapping faces)")
         edge_faces = np.full((n_edges, 2), -1, dtype=np.int64)
         edge_faces[slot % n_edges, slot // n_edges] = face_of
+        self._side_slots = _frozen(slot)
         n_sides = (edge_faces >= 0).sum(axis=1)
         for e in np.flatnonzero(n_sides == 0):
             self._fail(f"edge {e} belongs to no face")

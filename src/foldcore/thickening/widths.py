@@ -118,7 +118,7 @@ def collinear_groups(pattern) -> np.ndarray:
 
     loops = pattern.face_loops
     following = next_in_loop(loop_starts(loops.lengths), loops.lengths)
-    side = _side_edges(pattern, loops.flat, loops.flat[following])
+    side = pattern.side_slots % pattern.n_edges
     before = np.empty_like(following)
     before[following] = np.arange(len(following))   # the side ending at each corner
     xy = pattern.vertices
@@ -131,15 +131,6 @@ def collinear_groups(pattern) -> np.ndarray:
     graph = coo_matrix((np.ones(int(straight.sum())), (side[before][straight], side[straight])),
                        shape=(n, n))
     return connected_components(graph, directed=False)[1]
-
-
-def _side_edges(pattern, u, v) -> np.ndarray:
-    """The edge id of each face side u → v."""
-    n = pattern.n_vertices
-    keys = np.minimum(pattern.edges[:, 0], pattern.edges[:, 1]) * n \
-        + np.maximum(pattern.edges[:, 0], pattern.edges[:, 1])
-    order = np.argsort(keys)
-    return order[np.searchsorted(keys[order], np.minimum(u, v) * n + np.maximum(u, v))]
 
 
 def resolve_hinges(pattern, hinge) -> np.ndarray:
