@@ -68,8 +68,9 @@ def pattern_from_lines(segments: np.ndarray, kinds, angles, owners, source: str,
         (:func:`in_drawing_order`; default the file's).
     with_drawn : bool
         Return (pattern, drawn) instead: ``drawn`` (V, 2) mm, each vertex of the
-        pattern as first drawn, before merging (copies along a cut as their
-        vertex), which Origami Simulator's reading keeps.
+        pattern at the point Origami Simulator keeps of its cluster before merging
+        (the last drawn; :func:`in_drawing_order`; copies along a cut as their
+        vertex).
 
     Returns
     -------
@@ -204,13 +205,13 @@ def _node_and_merge(segments: np.ndarray, tol: float, source: str):
 
 
 def in_drawing_order(vertices: np.ndarray, edges: np.ndarray, segments: np.ndarray,
-                     tol: float, drawn: np.ndarray | None = None):
+                     tol: float, drawn: np.ndarray):
     """(vertices, edges, drawn) renumbered in the order the drawing first reaches each
     vertex (the segments' endpoints in their order; crossings after them, as they
     were), as Origami Simulator numbers them: the diagonal a thin sheet cuts a square
     along follows the numbering (:func:`foldcore.sheet.build.face_triangles`).
     ``drawn`` (V, 2): the endpoint that last reaches each vertex as drawn (in the
-    given ``drawn`` segments, (S, 2, 2), before snapping: default ``segments``), before
+    given ``drawn`` segments, (S, 2, 2): ``segments`` before snapping), before
     merging — the point Origami Simulator keeps of a cluster (its
     ``collapseNearbyVertices`` numbers a cluster by its first point and keeps the
     coordinates of its last) — or the vertex itself."""
@@ -223,7 +224,7 @@ def in_drawing_order(vertices: np.ndarray, edges: np.ndarray, segments: np.ndarr
     order = np.lexsort((np.arange(len(vertices)), first))
     new_id = np.empty(len(vertices), dtype=np.int64)
     new_id[order] = np.arange(len(vertices))
-    ends = (segments if drawn is None else drawn).reshape(-1, 2)
+    ends = drawn.reshape(-1, 2)
     last = np.full(len(vertices), -1, dtype=np.int64)
     np.maximum.at(last, nearest[reached], np.flatnonzero(reached))
     drawn = np.where((last >= 0)[:, None], ends[last], vertices)
