@@ -69,43 +69,40 @@ def _faces_by_size(pattern) -> list:
 
 
 def inset_faces(pattern, widths):
-    """(corners, failing): each face's inset corners ((m, 2) mm) by half of ``widths``
-    (E,) mm, and (F,) bool, the faces whose panel that makes vanish or turn inside out."""
+    """(corners, failing, mismatched): each face's inset corners ((m, 2) mm) by half of
+    ``widths`` (E,) mm, the faces of one vertex count computed together
+    (docs/architecture.md#building-the-thick-mesh-fast); (F,) bool, the faces whose
+    panel that makes vanish or turn inside out; (F,) int, per face a vertex where two
+    collinear sides have different widths (−1: none)."""
     offsets = _face_offsets(pattern, widths)
-    corners, failing = [None] * len(pattern.faces), np.zeros(len(pattern.faces), dtype=bool)
+    corners = [None] * len(pattern.faces)
+    failing = np.zeros(len(pattern.faces), dtype=bool)
+    mismatched = np.full(len(pattern.faces), -1, dtype=np.int64)
     for group in _faces_by_size(pattern):
         p = pattern.vertices[np.array([pattern.faces[f] for f in group])]
-        inset = _inset_corners(p, np.array([offsets[f] for f in group]))[0]
+        inset, uneven = _inset_corners(p, np.array([offsets[f] for f in group]))
         failing[group] = _inset_fails(p, inset)
         for row, f in enumerate(group):
             corners[f] = inset[row]
-    return corners, failing
+            if uneven[row].any():
+                mismatched[f] = pattern.faces[f][int(np.flatnonzero(uneven[row])[0])]
+    return corners, failing, mismatched
 
 
 def panel_corners(pattern, widths, table):
-    """Each face's inset corners ((m, 2) mm) and their point ids (added to ``table``
-    face by face), the faces of one vertex count computed together
-    (docs/architecture.md#building-the-thick-mesh-fast). Raises on the first face (by id)
-    whose inset fails."""
-    offsets = _face_offsets(pattern, widths)
-    corners = [None] * len(pattern.faces)
-    failed = {}  # face → message
-    for group in _faces_by_size(pattern):
-        p = pattern.vertices[np.array([pattern.faces[f] for f in group])]
-        inset, mismatched = _inset_corners(p, np.array([offsets[f] for f in group]))
-        fails = _inset_fails(p, inset)
-        for row, f in enumerate(group):
-            corners[f] = inset[row]
-            if mismatched[row].any():
-                vertex = pattern.faces[f][int(np.flatnonzero(mismatched[row])[0])]
-                failed[f] = (f"{pattern.source}: face {f}: two collinear sides at vertex "
-                             f"{vertex} have different hinge widths")
-            elif fails[row]:
-                failed[f] = (f"{pattern.source}: face {f}: hinge widths are too large for "
-                             "this face (its panel would vanish or turn inside out); use "
-                             "narrower hinges or a larger pattern")
-    if failed:
-        raise MeshError(failed[min(failed)])
+    """Each face's inset corners ((m, 2) mm, :func:`inset_faces`) and their point ids
+    (added to ``table`` face by face). Raises on the first face (by id) whose inset
+    fails."""
+    corners, failing, mismatched = inset_faces(pattern, widths)
+    bad = np.flatnonzero(failing | (mismatched >= 0))
+    if len(bad):
+        f = int(bad[0])
+        if mismatched[f] >= 0:
+            raise MeshError(f"{pattern.source}: face {f}: two collinear sides at vertex "
+                            f"{mismatched[f]} have different hinge widths")
+        raise MeshError(f"{pattern.source}: face {f}: hinge widths are too large for this "
+                        "face (its panel would vanish or turn inside out); use narrower "
+                        "hinges or a larger pattern")
     return corners, [table.extend(c) for c in corners]
 
 

@@ -96,7 +96,7 @@ def fit_widths(pattern, widths, automatic) -> np.ndarray:
     share = np.ones(len(widths))
     group = collinear_groups(pattern)
     for _ in range(MAX_NARROWING):
-        corners, failing = inset_faces(pattern, widths * share)
+        corners, failing, _ = inset_faces(pattern, widths * share)
         around = np.isin(pattern.edge_faces, np.flatnonzero(failing)).any(axis=1)
         if not failing.any():
             ends = np.unique(pattern.edges[short_creases(pattern, corners)])
