@@ -155,16 +155,30 @@ def trust_signs(angles: list, assignments, source: str) -> list:
     return out
 
 
-def on_one_plane(xyz: np.ndarray) -> bool:
-    """Whether the points (V, 3) lie on one plane (within :data:`PLANE_TOLERANCE` of
-    their extent)."""
-    centre = xyz.mean(axis=0)
-    _, _, rows = np.linalg.svd(xyz - centre, full_matrices=False)
-    extent = float(np.ptp(xyz, axis=0).max())
-    return float(np.abs((xyz - centre) @ rows[2]).max()) <= PLANE_TOLERANCE * extent
+@dataclass(frozen=True)
+class PlaneFit:
+    """The plane nearest points (V, 3): its unit ``normal``, the largest distance of a
+    point from it (``spread``) and the points' ``extent`` (same units)."""
+
+    normal: np.ndarray
+    spread: float
+    extent: float
+
+    @classmethod
+    def of(cls, xyz: np.ndarray) -> "PlaneFit":
+        centre = xyz.mean(axis=0)
+        _, _, rows = np.linalg.svd(xyz - centre, full_matrices=False)
+        return cls(rows[2], float(np.abs((xyz - centre) @ rows[2]).max()),
+                   float(np.ptp(xyz, axis=0).max()))
+
+    @property
+    def flat(self) -> bool:
+        """Whether the points lie on the plane, within :data:`PLANE_TOLERANCE` of their
+        extent."""
+        return self.spread <= PLANE_TOLERANCE * self.extent
 
 
-def into_plane(xyz: np.ndarray, faces, source: str) -> np.ndarray:
+def into_plane(xyz: np.ndarray, faces, source: str, fit: PlaneFit | None = None) -> np.ndarray:
     """(V, 2) coordinates of a flat sheet given in 3D in any plane, rotated into z = 0.
 
     Parameters
@@ -173,22 +187,22 @@ def into_plane(xyz: np.ndarray, faces, source: str) -> np.ndarray:
         Vertex coordinates, mm.
     faces : list of lists of int or None
         ``faces_vertices``, which fix the normal (module docstring).
+    fit : PlaneFit, optional
+        The points' plane, when the caller has it.
 
     Raises
     ------
     PatternError
         The vertices are not on one plane (a folded form).
     """
-    centre = xyz.mean(axis=0)
-    _, _, rows = np.linalg.svd(xyz - centre, full_matrices=False)
-    extent = float(np.ptp(xyz, axis=0).max())
-    spread = float(np.abs((xyz - centre) @ rows[2]).max())
-    if not spread <= PLANE_TOLERANCE * extent:
+    fit = PlaneFit.of(xyz) if fit is None else fit
+    spread, extent = fit.spread, fit.extent
+    if not fit.flat:
         raise PatternError(
             f"{source}: the vertices are not on one plane (off it by up to {spread:g}, "
             f"{spread / extent:.1e} of the sheet): a folded form; foldcore reads the crease "
             "pattern from vertices_flatUnfoldCoords or a 2D key frame")
-    normal = _oriented_normal(xyz, faces, rows[2])
+    normal = _oriented_normal(xyz, faces, fit.normal)
     rotated = xyz @ _rotation_onto_z(normal).T  # z is now the plane's offset: dropped
     angle = math.degrees(math.acos(max(-1.0, min(1.0, float(normal[2])))))
     note(source, f"a flat sheet off the z = 0 plane (normal {_vector(normal)}): rotated "

@@ -63,7 +63,7 @@ from ..hinges import HINGE_MODELS
 from ..pattern import DEFAULT_MAX_ANGLE_DEG, CreasePattern
 from ..planar import Loops, derive_face_loops, freeze, has_repeats, loop_starts, next_in_loop
 from .conventions import (Reading, assigned_angles, crease_pattern_frame, into_plane, note,
-                          on_one_plane, trust_signs)
+                          PlaneFit, trust_signs)
 from .fold_json import (ARRAY, CELLS_KEY, EDGE_STIFFNESS_KEY,  # noqa: F401  (part of this API)
                         FACE_STIFFNESS_KEY, HINGE_KEY, MAX_ANGLE_KEY, POISSON_KEY, TARGET_KEY,
                         THICKNESS_KEY, UNIT_MM, WIDTH_KEY, check_length, fail, has_class, index,
@@ -292,13 +292,15 @@ def _coords(rows: list, scale: float, source: str, faces=None, folded: bool = Fa
         mm = xy[:, :2] * scale
     bad = ~np.isfinite(xy).all(axis=1) | ~np.isfinite(mm).all(axis=1)
     in_3d = xy.shape[1] == 3 and not bad.any() and (xy[:, 2] != 0).any()
-    if in_3d and not (faces and not on_one_plane(xy)):
+    xyz = xy * scale if in_3d or folded and not bad.any() else None
+    fit = PlaneFit.of(xyz) if in_3d else None
+    if in_3d and (fit.flat or not faces):
         if folded:  # Origami Simulator labels its flat exports so
             note(source, "labelled a folded form (frame_classes: foldedForm) without "
                          "vertices_flatUnfoldCoords, on one plane: read as the crease pattern")
-        return into_plane(xy * scale, faces, source)
-    if (in_3d or folded and not bad.any()) and faces:
-        return _unfolded(xy * scale, faces, source)
+        return into_plane(xyz, faces, source, fit)
+    if xyz is not None and faces:
+        return _unfolded(xyz, faces, source)
     if folded:
         note(source, "labelled a folded form (frame_classes: foldedForm) without "
                      "vertices_flatUnfoldCoords or faces to unfold: its coordinates are read "
