@@ -149,9 +149,8 @@ def _strokes(source: str):
             raise PatternError(f"{source}: {name} cannot be computed "
                                f"({_failure(exc)})") from None
         segments += found
-        tag = type(element).__name__.lower().replace("simpleline", "line")
-        ranks += [(READ_ORDER.index(kind), TAG_ORDER.get(tag, len(TAG_ORDER)), number)] \
-            * len(found)
+        rank = (READ_ORDER.index(kind), TAG_ORDER.get(_tag(element), len(TAG_ORDER)), number)
+        ranks += [rank] * len(found)
         kinds += [kind] * len(found)
         angles += [angle] * len(found)
         owners += [name] * len(found)
@@ -288,10 +287,14 @@ def _failure(exc: BaseException) -> str:
     return f"{type(exc).__name__}: {' '.join(str(exc).split())[:120]}"
 
 
+def _tag(element) -> str:
+    """The SVG element kind of an svgelements shape (``line``, ``path``, ``rect``...)."""
+    return type(element).__name__.lower().replace("simpleline", "line")
+
+
 def _element_name(element, number: int) -> str:
-    tag = type(element).__name__.lower().replace("simpleline", "line")
     ident = element.values.get("id")
-    return f"{tag} {number}" + (f" (id {ident!r})" if ident else "")
+    return f"{_tag(element)} {number}" + (f" (id {ident!r})" if ident else "")
 
 
 def _stroke_type(element):
