@@ -167,8 +167,6 @@ def planarise(segments: np.ndarray, tol: float, source: str = "<segments>", numb
     coordinates merged, crossings and overlaps noded (shapely's unary union);
     vertices numbered as the segments in ``numbering``'s order reach them
     (:func:`in_drawing_order`)."""
-    import shapely
-
     from ..planar import crossing_pairs
 
     drawn = segments

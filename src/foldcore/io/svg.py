@@ -50,7 +50,6 @@ import re
 import numpy as np
 
 from ..errors import PatternError
-from ..pattern import CreasePattern
 from .conventions import Reading, note
 from .lines import check_meetings, pattern_from_lines
 from .svg_screen import screened_svg
@@ -104,7 +103,7 @@ def read_svg(path, reading: Reading | None = None, with_drawn: bool = False):
     ------
     PatternError
         Not an SVG, no creases, conflicting types on one segment, or a
-        malformed pattern (named as :class:`CreasePattern` names it).
+        malformed pattern (named as :class:`foldcore.pattern.CreasePattern` names it).
     """
     source = os.fspath(path)
     reading = Reading() if reading is None else reading
