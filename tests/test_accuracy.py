@@ -105,3 +105,21 @@ def test_miura_driven_by_one_crease_follows_rigid_folding(tmp_path, n, width_ove
     achieved = cli_fold(tmp_path, pattern, thickness)
     creases = patterns.miura_edge_kinds(n, n) != "boundary"
     assert np.abs(achieved[creases] - expected[creases]).max() < BOUND
+
+
+def test_driving_one_crease_of_a_file_that_targets_all_four(tmp_path):
+    """``--drive 0`` on a vertex whose file gives every crease a target (the others
+    deliberately wrong: 10° each way) folds as if only crease 0 had one: the
+    other three follow the closed form of mode A, not their targets."""
+    sectors = SECTORS[0]
+    pattern = patterns.degree4_vertex(sectors=sectors, radius=R, widths=[W] * 4,
+                                      mode="A", rho1=70.0)
+    angles = pattern.fold_angles.copy()
+    angles[1:4] = [10.0, 10.0, -10.0]
+    src, out = tmp_path / "all.fold", tmp_path / "out.fold"
+    write_fold(src, pattern.replace(fold_angles=angles))
+    assert main(["simulate", str(src), "--thickness", repr(H), "--drive", "0",
+                 "-o", str(out)]) == 0
+    achieved = np.array(json.loads(out.read_text())["edges_foldAngle"][:4], dtype=float)
+    closed = kinematics.degree4_deg(sectors[0], sectors[1], 70.0, "A")
+    assert np.abs(achieved - closed).max() < BOUND

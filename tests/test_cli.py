@@ -371,3 +371,15 @@ def test_a_negative_number_in_exponent_form_is_a_value():
     assert args.ground == -100.0 and args.fold_percent == -5.0
     with pytest.raises(SystemExit):
         build_parser().parse_args(["simulate", "p.fold", "--ground", "-e2"])
+
+
+@pytest.mark.parametrize("drive, words", [("1", "cannot drive edge 1: it is a boundary"),
+                                          ("3-1", "argument --drive: expected edge ids"),
+                                          ("0,x", "argument --drive: expected edge ids")])
+def test_drive_refuses_what_it_cannot_drive_in_one_line(fold_file, tmp_path, capsys, drive,
+                                                        words):
+    out = tmp_path / "o.fold"
+    assert main(["simulate", str(fold_file), "--drive", drive, "-o", str(out)]) == 2
+    (line,) = capsys.readouterr().err.splitlines()
+    assert words in line
+    assert not out.exists()

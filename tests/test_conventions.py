@@ -234,3 +234,27 @@ def test_a_2d_folded_form_without_faces_is_read_as_drawn_and_says_so():
     pattern, said = read_said(flat)
     assert pattern.area() == pytest.approx(1.0)
     assert [m for m in said if "without vertices_flatUnfoldCoords or faces" in m]
+
+
+def test_drive_keeps_only_the_given_targets_and_says_how_many_it_released():
+    d = fold_json(four_squares())  # targets on creases 8, 10 and 11; 9 passive
+    pattern, said = read_said(d, Reading(drive=[10]))
+    assert pattern.fold_angles[10] == 45.5
+    assert np.isnan(pattern.fold_angles[[8, 9, 11]]).all()
+    assert any("2 creases with a target left passive" in m and "reading.drive" in m
+               for m in said)
+
+
+@pytest.mark.parametrize("drive, words", [([2], "edge 2: it is a boundary edge"),
+                                          ([40], "edge 40: the pattern has 12 edges"),
+                                          ([8, 99], "edge 99"),
+                                          ([9], "edge 9: it has no target angle")])
+def test_drive_refuses_an_edge_it_cannot_drive_naming_it(drive, words):
+    with pytest.raises(PatternError, match=words):
+        read_said(fold_json(four_squares()), Reading(drive=drive))
+
+
+@pytest.mark.parametrize("drive", [[], [-1], [True], [1.5], "3", [0] * 1_000_001])
+def test_drive_is_a_non_empty_list_of_edge_ids(drive):
+    with pytest.raises(ValueError, match="drive"):
+        Reading(drive=drive)

@@ -31,7 +31,7 @@ from .destinations import check_destinations
 from .errors import FoldcoreError
 from . import interrupts, result_commands
 from .limits import (CELL_RATIO, GROUND_RATIO, LENGTH_MM, MARGIN_RATIO, MAX_ELASTIC_VERTICES,
-                     MAX_ITERATIONS, MAX_MESH_VERTICES, STROKE_RATIO, SUBDIVISIONS,
+                     MAX_DRIVEN, MAX_ITERATIONS, MAX_MESH_VERTICES, STROKE_RATIO, SUBDIVISIONS,
                      THICKNESS_RATIO, TOLERANCE, WIDTH_RATIO)
 from .options import CONTACT_CHOICES, MAX_FPS, MAX_FRAMES
 from .study import commands as study_commands
@@ -93,6 +93,26 @@ def _size(text: str) -> tuple[int, int]:
         return parse_size(text)
     except RenderError as exc:
         raise argparse.ArgumentTypeError(str(exc))
+
+
+def _edge_ids(text: str) -> tuple:
+    """Edge ids from ``"3,7,10-12"`` (ranges inclusive), at most MAX_DRIVEN of them."""
+    ids = []
+    for item in text.split(","):
+        lo, _, hi = item.strip().partition("-")
+        try:
+            first, last = int(lo), int(hi or lo)
+        except ValueError:
+            first, last = -1, -1
+        if not 0 <= first <= last:
+            raise argparse.ArgumentTypeError(
+                f"expected edge ids like 3,7,10-12 (integers ≥ 0, ranges low-high), "
+                f"got {item.strip()!r}")
+        if len(ids) + last - first + 1 > MAX_DRIVEN:
+            raise argparse.ArgumentTypeError(f"at most {MAX_DRIVEN:,} edge ids, got more "
+                                             f"({item.strip()!r})")
+        ids.extend(range(first, last + 1))
+    return tuple(ids)
 
 
 def _frames(text: str) -> int:
@@ -165,6 +185,10 @@ def _add_reading(sim) -> None:
                      help="in a FOLD file without edges_foldAngle, M/V creases stay passive "
                           "(default: they fold to -/+180 degrees x the fold percent, as in "
                           "Origami Simulator)")
+    sim.add_argument("--drive", type=_edge_ids, metavar="EDGES",
+                     help="drive only these creases (edge ids as read, e.g. 3,7,10-12): "
+                          "every other crease with a target is left passive (F edges "
+                          "keep 0 degrees); default: every crease with a target")
     sim.add_argument("--trust-assignment", action="store_true",
                      help="an angle whose sign contradicts its M/V assignment takes the "
                           "assignment's sign (default: refused, naming the edge)")
@@ -381,7 +405,7 @@ def option_groups(args) -> dict:
     return {"hinges": args.hinges,
             "reading": Reading(mv_without_angle="passive" if args.mv_passive else "fold",
                                trust_assignment=args.trust_assignment, scale=args.scale,
-                               size=args.sheet_size),
+                               size=args.sheet_size, drive=args.drive),
             "thickening": Thickening(args.thickness, args.hinge_width, args.subdivisions,
                                      args.hinge, args.elastic_cells),
             "solving": Solving(args.fold_percent, args.solver, args.tolerance,

@@ -48,6 +48,10 @@ TOLERANCE = (1e-15, 1e-2)
 #: Iteration budget accepted per run: the report lists every iteration's energy
 #: (10⁶ of them are about 20 MB of JSON).
 MAX_ITERATIONS = 1_000_000
+#: Creases a run may be told to drive by id (``--drive``): more than a pattern of
+#: any file the readers take has creases worth listing, and a list of them about
+#: 40 MB.
+MAX_DRIVEN = 1_000_000
 
 
 def sheet_extent(vertices) -> float:

@@ -266,4 +266,5 @@ FLAGS = {
     "reading.size": "--sheet-size",
     "reading.mv_without_angle='passive'": "--mv-passive",
     "reading.trust_assignment=True": "--trust-assignment",
+    "reading.drive": "--drive",
 }

@@ -155,7 +155,10 @@ class CreasePattern:
                     fold_angles=self.fold_angles, widths=self.widths,
                     max_angles=self.max_angles, faces=self._loops, source=self.source)
         args.update(changes)
-        return CreasePattern(**args)
+        out = CreasePattern(**args)
+        if "vertices" not in changes:
+            out.copied_from = self.copied_from
+        return out
 
     def __repr__(self) -> str:
         counts = {a: int(np.count_nonzero(self.assignments == a)) for a in ASSIGNMENTS}

@@ -13,7 +13,7 @@ from pathlib import Path
 from ..errors import PatternError
 from ..files import check_input
 from ..pattern import CreasePattern
-from .conventions import Reading
+from .conventions import Reading, drive_only
 from .fold import MAX_FILE_BYTES, FoldFile, pattern_from_fold_dict, read_fold, read_fold_file
 from .fold_write import fold_dict, write_fold
 from .obj import mesh_edges, read_mesh, write_hinges, write_obj
@@ -100,6 +100,7 @@ def read_file(path, *, hinges=None, reading: Reading | None = None) -> FoldFile:
         if reading.scale is not None or reading.size is not None:
             raise PatternError(f"{source}: a scale or sheet size applies to FOLD and SVG "
                                "patterns; an OBJ/STL mesh is read in mm")
-        return FoldFile(read_mesh(source, hinges), None, "mm")
+        return FoldFile(drive_only(read_mesh(source, hinges), reading.drive, source), None,
+                        "mm")
     raise PatternError(f"{source}: unknown crease-pattern file type {suffix or '(no suffix)'!r}"
                        " (expected .fold, .svg, .cp, .opx, .obj or .stl)")

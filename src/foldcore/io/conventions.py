@@ -27,6 +27,10 @@ al. 2018), so foldcore reads them as it does (its ``js/importer.js`` and
   :attr:`Reading.size` sets the sheet's larger extent in mm.
 * **Angles against their assignment** are refused; :attr:`Reading.
   trust_assignment` gives them the assignment's sign instead (said once).
+* **Driving some creases only**: :attr:`Reading.drive` lists the edges that
+  keep their targets; every other M, V or U crease with a target is left
+  passive (said once with the count). ``F`` edges keep theirs (0°: flat
+  facets, not folds).
 
 Every change is said once per file as a :class:`foldcore.errors.PatternWarning`
 (the command line prints one line per kind).
@@ -40,6 +44,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import PatternError, PatternWarning
+from ..limits import MAX_DRIVEN
 
 #: Out-of-plane spread, relative to the sheet's extent, below which a 3D sheet is flat
 #: (Origami Simulator's exports: coordinates printed to 6–17 digits).
@@ -65,12 +70,19 @@ class Reading:
     size : float or None
         Alternatively, the sheet's larger extent in mm (the file's lengths are
         scaled to it).
+    drive : tuple of int or None
+        Edge ids (the pattern's, as read: a FOLD file's own order) of the
+        creases that keep their target angles; every other crease with a
+        target, ``F`` edges aside, is left passive. None (default) drives
+        every crease with a target. Each id must be a crease with a target
+        (:func:`drive_only`).
     """
 
     mv_without_angle: str = "fold"
     trust_assignment: bool = False
     scale: float | None = None
     size: float | None = None
+    drive: tuple | None = None
 
     def __post_init__(self):
         if self.mv_without_angle not in ("fold", "passive"):
@@ -82,6 +94,15 @@ class Reading:
             value = getattr(self, name)
             if value is not None and not (value > 0 and math.isfinite(value)):
                 raise ValueError(f"{name} must be a positive finite number, got {value!r}")
+        if self.drive is not None:
+            ids = tuple(self.drive) if isinstance(self.drive, (list, tuple)) else None
+            if ids is not None and len(ids) > MAX_DRIVEN:
+                raise ValueError(f"drive lists {len(ids):,} edge ids; at most {MAX_DRIVEN:,}")
+            if not ids or not all(isinstance(e, (int, np.integer)) and not isinstance(e, bool)
+                                  and e >= 0 for e in ids):
+                raise ValueError(f"drive must be a non-empty list of edge ids (integers "
+                                 f"≥ 0), got {self.drive!r}")
+            object.__setattr__(self, "drive", tuple(int(e) for e in ids))
 
     def factor(self, extent_mm: float) -> float:
         """The factor every length is multiplied by, for a sheet ``extent_mm`` wide."""
@@ -139,6 +160,35 @@ def assigned_angles(assignments, source: str, reading: Reading,
     return [None if a not in ASSIGNED_ANGLE else
             ASSIGNED_ANGLE[a] * min(180.0, 180.0 if m is None else m) / 180.0
             for a, m in zip(assignments, limits)]
+
+
+def drive_only(pattern, drive, source: str):
+    """``pattern`` with only the creases ``drive`` (edge ids) keeping their target
+    angles, every other M, V or U crease left passive (said once); ``pattern``
+    itself for ``drive`` None. PatternError naming the first id that is not an
+    edge, is a boundary or cut, or has no target to drive."""
+    if drive is None:
+        return pattern
+    kinds, angles = pattern.assignments, pattern.fold_angles
+    for e in drive:
+        if e >= pattern.n_edges:
+            raise PatternError(f"{source}: cannot drive edge {e}: the pattern has "
+                               f"{pattern.n_edges} edges (ids 0 … {pattern.n_edges - 1})")
+        if kinds[e] in ("B", "C"):
+            raise PatternError(f"{source}: cannot drive edge {e}: it is a "
+                               f"{'boundary' if kinds[e] == 'B' else 'cut'} edge, not a crease")
+        if math.isnan(angles[e]):
+            raise PatternError(f"{source}: cannot drive edge {e}: it has no target angle "
+                               "(passive in the file); give it one in the file")
+    keep = np.zeros(pattern.n_edges, dtype=bool)
+    keep[list(drive)] = True
+    released = ~keep & ~np.isnan(angles) & (kinds != "F")
+    if not released.any():
+        return pattern
+    count = int(released.sum())
+    note(source, f"{count} crease{'s' if count != 1 else ''} with a target left passive: "
+                 f"only the {len(set(drive))} given in reading.drive are driven")
+    return pattern.replace(fold_angles=np.where(released, np.nan, angles))
 
 
 def trust_signs(angles: list, assignments, source: str) -> list:

@@ -32,7 +32,7 @@ import numpy as np
 
 from ..errors import PatternError
 from ..pattern import CreasePattern
-from .conventions import Reading, note
+from .conventions import Reading, drive_only, note
 from .lines import check_meetings, pattern_from_lines
 
 #: TYPE → (assignment, target angle in degrees); None: an auxiliary line.
@@ -67,8 +67,9 @@ def pattern_of_typed_lines(lines, source: str, reading: Reading | None) -> Creas
         raise PatternError(f"{source}: no border, mountain or valley line (types 1, 2, 3)")
     check_meetings(segments, source)
     extent = float(np.ptp(segments.reshape(-1, 2), axis=0).max())
-    return pattern_from_lines(segments, kinds, angles, owners, source,
-                              tol=MERGE * extent, factor=reading.factor(extent))
+    return drive_only(pattern_from_lines(segments, kinds, angles, owners, source,
+                                         tol=MERGE * extent, factor=reading.factor(extent)),
+                      reading.drive, source)
 
 
 def _lines(source: str):

@@ -62,7 +62,8 @@ from ..files import check_input
 from ..hinges import HINGE_MODELS
 from ..pattern import DEFAULT_MAX_ANGLE_DEG, CreasePattern
 from ..planar import Loops, derive_face_loops, freeze, has_repeats, loop_starts, next_in_loop
-from .conventions import (Reading, assigned_angles, crease_pattern_frame, into_plane, note,
+from .conventions import (Reading, assigned_angles, crease_pattern_frame, drive_only,
+                          into_plane, note,
                           PlaneFit, trust_signs)
 from .fold_json import (ARRAY, CELLS_KEY, EDGE_STIFFNESS_KEY,  # noqa: F401  (part of this API)
                         FACE_STIFFNESS_KEY, HINGE_KEY, MAX_ANGLE_KEY, POISSON_KEY, TARGET_KEY,
@@ -206,7 +207,7 @@ def _fold_file(d, source: str, reading: Reading | None, owned: bool) -> FoldFile
     args = dict(vertices=vertices, edges=edges, assignments=assignments,
                 fold_angles=fold_angles, widths=widths, max_angles=max_angles, faces=faces,
                 source=source)
-    pattern = build_pattern(args)
+    pattern = drive_only(build_pattern(args), reading.drive, source)
     return FoldFile(pattern, _thickness(d, scale, source, vertices), unit,
                     _stiffness(d, n, args["faces"], source), _hinge_models(d, n, source))
 

@@ -50,7 +50,7 @@ import re
 import numpy as np
 
 from ..errors import PatternError
-from .conventions import Reading, note
+from .conventions import Reading, drive_only, note
 from .lines import check_meetings, pattern_from_lines
 from .svg_screen import screened_svg
 
@@ -115,12 +115,14 @@ def read_svg(path, reading: Reading | None = None, with_drawn: bool = False):
     check_meetings(segments, source)
     segments[:, :, 1] *= -1.0  # SVG y points down
     extent = float(np.ptp(segments.reshape(-1, 2), axis=0).max())
-    return pattern_from_lines(segments, kinds, angles, owners, source,
+    read = pattern_from_lines(segments, kinds, angles, owners, source,
                               tol=min(SNAP_PX, SNAP_MAX * extent),
                               factor=reading.factor(extent * MM_PER_PX) * MM_PER_PX,
                               where=lambda x, y: f"({x:g}, {-y:g}) px",
                               sides_as_origami_simulator=True, numbering=numbering,
-                              with_drawn=with_drawn)
+                              with_drawn=True)
+    pattern, drawn = drive_only(read[0], reading.drive, source), read[1]
+    return (pattern, drawn) if with_drawn else pattern
 
 
 def _strokes(source: str):
