@@ -89,6 +89,26 @@ def test_the_page_is_self_contained_and_shows_each_frame(series, tmp_path):
     assert yellow(strained) > 0 and yellow(unstrained) == 0  # the largest strain: folded
 
 
+@pytest.mark.parametrize("colour, words", [
+    ("mv", ["mountain", "valley", "facet (F)", "undriven (U)", "panel"]),
+    ("angle", ["fold angle: mountain \u2212{a}\u00b0", "+{a}\u00b0 valley"]),
+    ("strain", ["largest surface strain of each hinge sub-strip: 0"])])
+def test_each_colouring_has_its_legend_with_the_scale_it_shows(series, tmp_path, colour,
+                                                               words):
+    """The angle legend's ends are the largest |angle| over the frames' creases."""
+    d = json.loads(series.read_text())
+    largest = max(abs(a) for f in d["file_frames"] for a in f["foldcore:pattern_foldAngle"]
+                  if a is not None)
+    page = tmp_path / "view.html"
+    assert main(["view", str(series), "-o", str(page)]) == 0
+    dom = chromium(f"file://{page}#colour={colour}", f"--user-data-dir={tmp_path / 'p'}",
+                   "--dump-dom").stdout
+    legend = dom[dom.index('id="legend"'):]
+    legend = legend[:legend.index("</div>")]
+    for w in words:
+        assert w.format(a=float(f"{largest:.3g}")).replace(".0\u00b0", "\u00b0") in legend
+
+
 def test_view_refuses_what_it_cannot_show_in_one_line(tmp_path, capsys):
     pattern = tmp_path / "p.svg"
     pattern.write_text("<svg/>")

@@ -9,7 +9,8 @@ has one) and three colourings: mountain/valley (Origami Simulator's red/blue,
 panels grey, facet yellow, undriven magenta), each crease's achieved fold
 angle (valley blue, mountain red), and each hinge sub-strip's larger surface
 strain (dark to yellow, 0 to the largest over the frames; as ``foldcore render
---color-by strain``). ``#frame=K&colour=angle`` in the URL
+--color-by strain``), each with its legend under the controls (the colours of
+the assignments; the angle and strain scales with their ends). ``#frame=K&colour=angle`` in the URL
 chooses the first view (used by the tests). Geometry: the outer surface of
 the thick mesh rebuilt from the file (:func:`foldcore.result_file.read_result`),
 float32 positions per frame, base64-encoded. A thin sheet's result (no
