@@ -17,7 +17,8 @@ from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
 from foldcore import patterns
-from foldcore.errors import MeshError
+from foldcore.errors import MeshError, PatternWarning
+from foldcore.simulation import Simulation
 from foldcore.pattern import CreasePattern
 from foldcore.thickening import auto_subdivisions, minimum_hinge_width, thicken
 
@@ -137,6 +138,14 @@ def panel_corner_near(mesh, face, point):
 
 
 # =================================================================== invariants
+def slit_end_points(pattern) -> list:
+    """Positions (2,) mm of the ends of boundary edges drawn twice (a cut's two sides)."""
+    xy = pattern.vertices[pattern.edges[pattern.assignments == "B"]]  # (B, 2, 2)
+    keys = [tuple(sorted(map(tuple, np.round(seg, 9).tolist()))) for seg in xy]
+    twice = {k for k in keys if keys.count(k) > 1}
+    return [np.array(p) for k in twice for p in k]
+
+
 def check_mesh(pattern, mesh, H, widths=None, ks=None):
     """All acceptance invariants (a)–(f) plus strip geometry; raises AssertionError."""
     creases = pattern.creases
@@ -162,10 +171,14 @@ def check_mesh(pattern, mesh, H, widths=None, ks=None):
         assert len(set(p.top.tolist())) == len(p.top), "repeated vertex in a prism"
         used[p.top] = True
     assert used.all(), "orphan points"
-    # conforming at points too: no two ids at the same place
+    # conforming at points too: no two ids at the same place, but at the ends of a
+    # slit's two sides (a cut), whose panels are apart
     near = shapely.STRtree(shapely.points(mesh.points)).query(
         shapely.points(mesh.points), predicate="dwithin", distance=1e-9 * scale)
-    assert (near[0] == near[1]).all(), "two point ids at the same position"
+    twins = near[0] != near[1]
+    slit_ends = slit_end_points(pattern)
+    assert all(any(np.allclose(mesh.points[i], q, atol=1e-9 * scale) for q in slit_ends)
+               for i in near[0][twins]), "two point ids at the same position"
     assert np.allclose(mesh.rest_positions[:M, 2], H / 2)
     assert np.allclose(mesh.rest_positions[M:, 2], -H / 2)
     assert all(len(p.top) == 4 for p in strips)
@@ -531,9 +544,10 @@ def test_straight_corner_equal_widths_builds():
     assert np.vstack(strip_coords(mesh, pattern, 1))[:, 0].min() == pytest.approx(0.5)
 
 
-def test_straight_corner_unequal_widths_refused():
-    with pytest.raises(MeshError, match=r"face 0\b.*vertex 1\b"):
-        thicken(t_vertex(2.0, 3.0, 1.0), 1.0, subdivisions=2)
+def test_straight_corner_unequal_widths_steps():
+    # the left panel's straight corner between creases of widths 2 and 3: a step
+    pattern = t_vertex(2.0, 3.0, 1.0)
+    check_mesh(pattern, thicken(pattern, 1.0, subdivisions=2), 1.0)
 
 
 def test_high_degree_vertex_waterbomb8_holes_at_centre():
@@ -708,17 +722,46 @@ def tee():
                          source="tee")
 
 
-def test_collinear_sides_of_unequal_width_named():
-    # a panel corner at a straight vertex exists only if both sides are offset alike
+def test_collinear_sides_of_unequal_width_step_the_panel():
+    """Creases 2 and 3 in line at vertex 3 with different widths: no mitre exists, so
+    the lower panel's outline steps from one strip's end to the other's, and the
+    sheet is still tiled exactly by panels and strips (check_mesh)."""
     pattern = tee()
     (face,) = set(pattern.edge_faces[2].tolist()) & set(pattern.edge_faces[3].tolist())
     widths = np.full(pattern.n_edges, 0.05)
-    widths[9] = 0.08  # the crossing crease may differ
+    widths[9] = 0.08  # the crossing crease
     check_mesh(pattern, thicken(pattern, 0.01, hinge_width=widths), 0.01)
-    widths[2] = 0.08  # the two in line may not
-    with pytest.raises(MeshError, match=rf"tee: face {face}: two collinear sides at vertex 3 "
-                                        "have different hinge widths"):
-        thicken(pattern, 0.01, hinge_width=widths)
+    widths[2] = 0.08  # in line with crease 3 (0.05)
+    mesh = thicken(pattern, 0.01, hinge_width=widths)
+    check_mesh(pattern, mesh, 0.01)
+    (panel,) = [p for p in prisms_of(mesh) if p.kind == "rigid_panel" and p.index == face]
+    y = np.round(mesh.points[panel.top][:, 1], 12)
+    assert {0.96, 0.975} <= set(y)  # its upper side at each strip's half width
+
+
+def pop_up():
+    """A 4 × 2 mm sheet cut along y = 1 from x = 0 to 2, the line going on as a valley
+    crease from x = 2 to 4 (a pop-up's flap): the cut's sides are boundaries, in
+    line with the crease at (2, 1)."""
+    v = [(0, 0), (4, 0), (4, 2), (0, 2), (0, 1), (2, 1), (4, 1)]
+    e = [(0, 1), (1, 6), (6, 2), (2, 3), (3, 4), (4, 0), (4, 5), (5, 6)]
+    return CreasePattern(v, e, ["B"] * 6 + ["C", "V"], fold_angles=[None] * 7 + [90.0],
+                         source="pop-up")
+
+
+def test_a_crease_going_on_as_a_cut_steps_both_panels_and_folds():
+    with pytest.warns(PatternWarning, match="cut"):
+        pattern = pop_up()
+    crease = int(np.flatnonzero(pattern.assignments == "V")[0])
+    mesh = thicken(pattern, 0.1, hinge_width=0.3)
+    check_mesh(pattern, mesh, 0.1)
+    for panel in (p for p in prisms_of(mesh) if p.kind == "rigid_panel"):
+        xy = mesh.points[panel.top][:, :2]
+        step = xy[np.isclose(xy[:, 0], 2.0)]  # each panel: the crease's end and the cut's
+        assert sorted(np.round(np.abs(step[:, 1] - 1.0), 12)) == [0.0, 0.15]
+    result = Simulation(mesh, pattern).run(tolerance=1e-10)
+    assert result.converged
+    assert result.fold_angles_deg[crease] == pytest.approx(90.0, abs=1e-3)
 
 
 def short_crease():

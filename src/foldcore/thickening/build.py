@@ -89,7 +89,7 @@ def _build(sheet, elastic, cell_size) -> ThickMesh:
     """:func:`thicken`'s mesh of its resolved ``sheet``."""
     pattern = sheet.pattern
     table = PointTable()
-    corners, corner_ids = panel_corners(pattern, sheet.widths, table)
+    corners, corner_ids, steps = panel_corners(pattern, sheet.widths, table)
     bars, plates, facets = split_elastic(pattern, elastic)
     plates = plate_counts(pattern, plates, corners, cell_size)
     segments = strip_segments(pattern, plates, sheet.stretch, bars)
@@ -97,7 +97,7 @@ def _build(sheet, elastic, cell_size) -> ThickMesh:
                                    (bars, plates, facets), cell_size), pattern.source)
     strip_points, inserts = build_strips(pattern, sheet.widths, sheet.ks, segments, corners,
                                          corner_ids, table)
-    loops = panel_loops(corner_ids, inserts)
+    loops = panel_loops(corner_ids, inserts, steps)
     cells, built = elastic_cells(pattern, loops, corner_ids, strip_points, (bars, plates, facets),
                                  table, cell_size)
     return _assemble(sheet, np.array(table.coords), strip_points, loops, cells, segments, built)

@@ -1,4 +1,13 @@
-"""Panels: each face inset by half the hinge width of each of its sides (mitered, Eq. 1)."""
+"""Panels: each face inset by half the hinge width of each of its sides (mitered, Eq. 1).
+
+Where two sides of a face meet in line at a vertex but are inset by different
+amounts (a crease that goes on as a cut or a boundary, as in pop-ups; collinear
+creases of different widths) there is no mitre: the panel steps across at the
+vertex, square to the sides. Its corner there is on the side leaving the
+vertex, and the point on the side arriving is a *step* point of the outline
+(a strip's end where that side is a crease, which the strip puts there;
+:func:`panel_corners` adds it where the side is a boundary).
+"""
 from __future__ import annotations
 
 import numpy as np
@@ -25,7 +34,8 @@ def _inset_corners(p, offsets):
         mm.
     mismatched : (n, m) bool
         Where the two sides meeting at a vertex are collinear but offset by
-        different amounts (no corner; ``corners`` holds the side's point there).
+        different amounts (a step: ``corners`` holds the leaving side's point
+        there, module docstring).
     """
     d = np.roll(p, -1, axis=1) - p
     u = d / np.linalg.norm(d, axis=2)[..., None]
@@ -36,17 +46,14 @@ def _inset_corners(p, offsets):
     straight = np.abs(denom) < 1e-9
     mismatched = straight & (np.abs(offsets - off_in) > 1e-9 * (1 + offsets))
     t = np.where(straight, 0.0, cross2d(rhs, u) / np.where(straight, 1.0, denom))
-    return p + off_in[..., None] * n_in + t[..., None] * u_in, mismatched
+    mitred = p + off_in[..., None] * n_in + t[..., None] * u_in
+    return np.where(mismatched[..., None], p + offsets[..., None] * n, mitred), mismatched
 
 
-def _face_offsets(pattern, widths) -> list[np.ndarray]:
-    """Inward offset (mm) of each side of each face: half its hinge width, 0 on B."""
-    key = {}
-    for e, (a, b) in enumerate(pattern.edges):
-        key[(int(a), int(b))] = key[(int(b), int(a))] = e
-    half = np.nan_to_num(0.5 * widths)
-    return [np.array([half[key[(int(a), int(b))]] for a, b in zip(f, np.roll(f, -1))])
-            for f in pattern.faces]
+def _side_edges(pattern) -> list[np.ndarray]:
+    """Per face, (m,) int: the edge along each side (side i from its vertex i to i + 1)."""
+    lengths = pattern.face_loops.lengths
+    return np.split(pattern.side_slots % pattern.n_edges, np.cumsum(lengths)[:-1])
 
 
 def _inset_fails(p, corners) -> np.ndarray:
@@ -69,41 +76,45 @@ def _faces_by_size(pattern) -> list:
 
 
 def inset_faces(pattern, widths):
-    """(corners, failing, mismatched): each face's inset corners ((m, 2) mm) by half of
+    """(corners, failing, steps): each face's inset corners ((m, 2) mm) by half of
     ``widths`` (E,) mm, the faces of one vertex count computed together
     (docs/architecture.md#building-the-thick-mesh-fast); (F,) bool, the faces whose
-    panel that makes vanish or turn inside out; (F,) int, per face a vertex where two
-    collinear sides have different widths (−1: none)."""
-    offsets = _face_offsets(pattern, widths)
+    panel that makes vanish or turn inside out; per face, {place in its loop: the
+    step point (2,) mm before that corner} where its outline steps and the side
+    arriving there is a boundary (module docstring)."""
+    sides = _side_edges(pattern)
+    half = np.nan_to_num(0.5 * np.asarray(widths, dtype=float))
     corners = [None] * len(pattern.faces)
     failing = np.zeros(len(pattern.faces), dtype=bool)
-    mismatched = np.full(len(pattern.faces), -1, dtype=np.int64)
+    steps = [dict() for _ in pattern.faces]
+    boundary = pattern.assignments == "B"
     for group in _faces_by_size(pattern):
         p = pattern.vertices[np.array([pattern.faces[f] for f in group])]
-        inset, uneven = _inset_corners(p, np.array([offsets[f] for f in group]))
+        inset, uneven = _inset_corners(p, np.array([half[sides[f]] for f in group]))
         failing[group] = _inset_fails(p, inset)
         for row, f in enumerate(group):
             corners[f] = inset[row]
-            if uneven[row].any():
-                mismatched[f] = pattern.faces[f][int(np.flatnonzero(uneven[row])[0])]
-    return corners, failing, mismatched
+            for i in np.flatnonzero(uneven[row]):
+                if boundary[sides[f][i - 1]]:  # the side arriving at vertex i
+                    steps[f][int(i)] = p[row, i]
+    return corners, failing, steps
 
 
 def panel_corners(pattern, widths, table):
-    """Each face's inset corners ((m, 2) mm, :func:`inset_faces`) and their point ids
-    (added to ``table`` face by face). Raises on the first face (by id) whose inset
-    fails."""
-    corners, failing, mismatched = inset_faces(pattern, widths)
-    bad = np.flatnonzero(failing | (mismatched >= 0))
+    """Each face's inset corners ((m, 2) mm, :func:`inset_faces`), their point ids
+    (added to ``table`` face by face) and, per face, {place: [id of its step point]}
+    (:func:`inset_faces`; for :func:`panel_loops`). Raises on the first face (by id)
+    whose inset fails."""
+    corners, failing, steps = inset_faces(pattern, widths)
+    bad = np.flatnonzero(failing)
     if len(bad):
-        f = int(bad[0])
-        if mismatched[f] >= 0:
-            raise MeshError(f"{pattern.source}: face {f}: two collinear sides at vertex "
-                            f"{mismatched[f]} have different hinge widths")
-        raise MeshError(f"{pattern.source}: face {f}: hinge widths are too large for this "
-                        "face (its panel would vanish or turn inside out); use narrower "
-                        "hinges or a larger pattern")
-    return corners, [table.extend(c) for c in corners]
+        raise MeshError(f"{pattern.source}: face {int(bad[0])}: hinge widths are too large "
+                        "for this face (its panel would vanish or turn inside out); use "
+                        "narrower hinges or a larger pattern")
+    ids = [table.extend(c) for c in corners]
+    step_ids = [{(i - 1) % len(corners[f]): [table.add(point)] for i, point in step.items()}
+                for f, step in enumerate(steps)]
+    return corners, ids, step_ids
 
 
 def corner_lookup(pattern) -> dict:
@@ -115,14 +126,15 @@ def corner_lookup(pattern) -> dict:
     return lookup
 
 
-def panel_loops(corner_ids, inserts) -> list:
-    """Footprint point ids of each panel: its corners with the strip ends inserted
-    (``inserts[f]``: {corner place: ids inserted after it})."""
+def panel_loops(corner_ids, inserts, steps) -> list:
+    """Footprint point ids of each panel: its corners with the strip ends and the step
+    points inserted (``inserts[f]``, ``steps[f]``: {corner place: ids inserted after
+    it}; a step point comes last, nearest the next corner)."""
     loops = []
     for f, ids in enumerate(corner_ids):
         loop = []
         for i, cid in enumerate(ids):
             loop.append(cid)
-            loop += inserts[f].get(i, [])
+            loop += inserts[f].get(i, []) + steps[f].get(i, [])
         loops.append(loop)
     return loops
