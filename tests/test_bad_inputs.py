@@ -176,6 +176,16 @@ def test_an_input_that_is_not_a_regular_file_is_refused_before_it_is_opened(
     nothing_written(out)
 
 
+@pytest.mark.parametrize("name", ["patterns", "patterns.fold"])
+def test_a_folder_given_as_the_pattern_is_refused_as_a_folder(name, tmp_path, out):
+    """A folder without a suffix was 'an unknown file type (no suffix)'."""
+    folder = tmp_path / name
+    folder.mkdir()
+    refused(foldcore("simulate", folder, "-o", out / "o.fold"),
+            f"{folder}: cannot read the file: it is a folder, not a regular file")
+    nothing_written(out)
+
+
 # ------------------------------------------------------------------ output names
 @pytest.mark.parametrize("args", [["simulate", "{hinge}", "-o", ""],
                                   ["simulate", "{hinge}", "--report", ""],

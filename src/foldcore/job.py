@@ -57,7 +57,8 @@ def simulate(path, *, hinges=None, reading=None, thickening=None, solving=None,
     Parameters
     ----------
     path : str or os.PathLike
-        ``.fold``, ``.svg``, or ``.obj``/``.stl`` with a hinge file.
+        ``.fold``, ``.svg``, ``.cp``, ``.opx``, or ``.obj``/``.stl`` with a hinge file
+        (:func:`foldcore.io.read_file`).
     hinges : path, optional
         Hinge file of an OBJ/STL pattern (default: PATH.hinges).
     reading : foldcore.io.Reading or dict, optional

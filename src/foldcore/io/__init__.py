@@ -81,9 +81,9 @@ def read_file(path, *, hinges=None, reading: Reading | None = None) -> FoldFile:
     if suffix in _PATTERNS and hinges is not None:
         raise PatternError(f"{source}: a hinge file only goes with an OBJ/STL mesh, "
                            f"not {_KINDS[suffix]}")
-    for given in (source, hinges):  # before any is opened: a named pipe blocks a read
-        if given is not None and suffix in (*_PATTERNS, *MESH_SUFFIXES):
-            check_input(given, PatternError)
+    check_input(source, PatternError)  # before it is opened: a named pipe blocks a read
+    if hinges is not None and suffix in MESH_SUFFIXES:
+        check_input(hinges, PatternError)
     if suffix == ".fold":
         return read_fold_file(source, reading)
     if suffix == ".svg":
