@@ -140,7 +140,7 @@ def test_a_folded_form_without_flat_coordinates_is_unfolded_from_its_faces(name)
     length (to the file's digits), the faces lie flat without overlapping (the
     pattern's checks), and the sheet's area is the faces' area in 3D; said once."""
     d = json.load(open(f"tests/data/real/{name}"))
-    pattern, said = read_said(d)
+    pattern, said = read_said(d, Reading(scale=1.0))  # in the file's numbers
     extent = float(np.ptp(pattern.vertices, axis=0).max())
     assert np.abs(_edge_lengths_3d(d, pattern) - pattern.edge_lengths()).max() < 1e-5 * extent
     xyz = np.array(d["vertices_coords"], dtype=float)
@@ -231,7 +231,7 @@ def test_a_2d_folded_form_without_faces_is_read_as_drawn_and_says_so():
     flat = json.load(open("tests/data/real/diagonal-cp.fold"))
     flat["frame_classes"] = ["foldedForm"]
     del flat["faces_vertices"]
-    pattern, said = read_said(flat)
+    pattern, said = read_said(flat, Reading(scale=1.0))
     assert pattern.area() == pytest.approx(1.0)
     assert [m for m in said if "without vertices_flatUnfoldCoords or faces" in m]
 

@@ -14,7 +14,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import foldcore.io as fio
-from foldcore.errors import PatternError
+from foldcore.errors import PatternError, PatternWarning
 from foldcore.io import fold as fold_module
 from foldcore.pattern import CreasePattern
 
@@ -172,7 +172,7 @@ def test_frame_unit_cm(tmp_path):
     assert got.frame_unit == "cm"
 
 
-@pytest.mark.parametrize("unit, mm", [("unit", 1.0), ("mm", 1.0), ("cm", 10.0), ("m", 1000.0),
+@pytest.mark.parametrize("unit, mm", [("mm", 1.0), ("cm", 10.0), ("m", 1000.0),
                                       ("in", 25.4), ("pt", 25.4 / 72.0), ("um", 1e-3),
                                       ("nm", 1e-6)])
 def test_every_frame_unit_is_its_length_in_mm(tmp_path, unit, mm):
@@ -187,6 +187,26 @@ def test_every_frame_unit_is_its_length_in_mm(tmp_path, unit, mm):
     np.testing.assert_allclose(got.pattern.vertices, p.vertices, rtol=1e-12, atol=1e-15)
     assert got.pattern.widths[6] == pytest.approx(0.25, rel=1e-12)
     assert got.thickness == pytest.approx(0.1, rel=1e-12)
+
+
+@pytest.mark.parametrize("declared", [None, "unit"])
+def test_a_file_without_a_unit_of_length_is_read_100_mm_across_and_says_so(tmp_path,
+                                                                            declared):
+    """Coordinates, widths and the thickness scale alike; a given scale or size wins."""
+    p = two_squares(width=0.25)  # 2 × 1 in the file's numbers
+    d = fold_json(p, **{"foldcore:thickness": 0.1})
+    d.pop("frame_unit", None)
+    if declared:
+        d["frame_unit"] = declared
+    path = write_json(tmp_path / "unitless.fold", d)
+    with pytest.warns(PatternWarning, match=r"no unit of length .*100 mm across \(1 unit = 50 mm\)"):
+        got = fio.read_fold_file(path)
+    np.testing.assert_allclose(got.pattern.vertices, p.vertices * 50.0, rtol=1e-12)
+    assert got.pattern.widths[6] == pytest.approx(12.5) and got.thickness == pytest.approx(5.0)
+    kept = fio.read_fold_file(path, fio.Reading(scale=1.0))  # the numbers as mm
+    np.testing.assert_array_equal(kept.pattern.vertices, p.vertices)
+    sized = fio.read_fold_file(path, fio.Reading(size=10.0))
+    np.testing.assert_allclose(sized.pattern.vertices, p.vertices * 5.0, rtol=1e-12)
 
 
 def test_a_3d_row_among_2d_ones_is_read_only_with_z_zero(tmp_path):

@@ -32,7 +32,7 @@ from .errors import FoldcoreError
 from . import interrupts, result_commands
 from .limits import (CELL_RATIO, GROUND_RATIO, LENGTH_MM, MARGIN_RATIO, MAX_ELASTIC_VERTICES,
                      MAX_DRIVEN, MAX_ITERATIONS, MAX_MESH_VERTICES, STROKE_RATIO, SUBDIVISIONS,
-                     THICKNESS_RATIO, TOLERANCE, WIDTH_RATIO)
+                     THICKNESS_RATIO, TOLERANCE, UNITLESS_SHEET_MM, WIDTH_RATIO)
 from .options import CONTACT_CHOICES, MAX_FPS, MAX_FRAMES
 from .study import commands as study_commands
 from .strategies import DEFAULT_SOLVER, SOLVERS
@@ -199,8 +199,8 @@ def _add_reading(sim) -> None:
                            f"{LENGTH_MM[0]:g} … {LENGTH_MM[1]:g} mm, as every length")
     size.add_argument("--sheet-size", type=_positive, metavar="MM",
                       help="scale the pattern so that its larger extent is MM millimetres, "
-                           f"{LENGTH_MM[0]:g} … {LENGTH_MM[1]:g} (a unit-square file is "
-                           "otherwise 1 mm wide)")
+                           f"{LENGTH_MM[0]:g} … {LENGTH_MM[1]:g} (a FOLD file that declares "
+                           f"no unit is otherwise {UNITLESS_SHEET_MM:g} mm across)")
 
 
 def _add_thickening(sim) -> None:

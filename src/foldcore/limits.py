@@ -48,6 +48,11 @@ TOLERANCE = (1e-15, 1e-2)
 #: Iteration budget accepted per run: the report lists every iteration's energy
 #: (10⁶ of them are about 20 MB of JSON).
 MAX_ITERATIONS = 1_000_000
+#: Larger extent, mm, of a FOLD sheet whose file declares no unit of length
+#: (``frame_unit`` absent or ``"unit"``: most files are unit squares), unless a
+#: size or a scale is given: a sheet of paper's order, on which millimetre
+#: thicknesses and hinge widths are what they say.
+UNITLESS_SHEET_MM = 100.0
 #: Creases a run may be told to drive by id (``--drive``): more than a pattern of
 #: any file the readers take has creases worth listing, and a list of them about
 #: 40 MB.

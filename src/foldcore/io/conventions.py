@@ -22,9 +22,11 @@ al. 2018), so foldcore reads them as it does (its ``js/importer.js`` and
   which keys would do. A key frame labelled a
   folded form whose ``file_frames`` hold a frame labelled ``creasePattern``
   (Rabbit Ear's files) is read from that frame (:func:`crease_pattern_frame`).
-* **Lengths**: ``frame_unit`` as before (a unit-square file is 1 mm wide);
-  :attr:`Reading.scale` multiplies every length of the file, or
-  :attr:`Reading.size` sets the sheet's larger extent in mm.
+* **Lengths**: ``frame_unit`` as before; a FOLD file that declares no unit
+  (``frame_unit`` absent or ``"unit"``: most are unit squares) is read
+  :data:`~foldcore.limits.UNITLESS_SHEET_MM` across (said once); :attr:`Reading.scale`
+  multiplies every length of the file (a unitless file's unit taken as mm),
+  or :attr:`Reading.size` sets the sheet's larger extent in mm.
 * **Angles against their assignment** are refused; :attr:`Reading.
   trust_assignment` gives them the assignment's sign instead (said once).
 * **Driving some creases only**: :attr:`Reading.drive` lists the edges that
@@ -44,7 +46,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import PatternError, PatternWarning
-from ..limits import MAX_DRIVEN
+from ..limits import MAX_DRIVEN, UNITLESS_SHEET_MM
 
 #: Out-of-plane spread, relative to the sheet's extent, below which a 3D sheet is flat
 #: (Origami Simulator's exports: coordinates printed to 6–17 digits).
@@ -104,10 +106,13 @@ class Reading:
                                  f"≥ 0), got {self.drive!r}")
             object.__setattr__(self, "drive", tuple(int(e) for e in ids))
 
-    def factor(self, extent_mm: float) -> float:
-        """The factor every length is multiplied by, for a sheet ``extent_mm`` wide."""
-        if self.size is not None:
-            return self.size / extent_mm if extent_mm > 0 else 1.0
+    def factor(self, extent_mm: float, unitless: bool = False) -> float:
+        """The factor every length is multiplied by, for a sheet ``extent_mm`` wide;
+        ``unitless``: the file declares no unit of length, so without a size or a
+        scale its larger extent becomes :data:`UNITLESS_SHEET_MM`."""
+        if self.size is not None or (unitless and self.scale is None):
+            size = UNITLESS_SHEET_MM if self.size is None else self.size
+            return size / extent_mm if extent_mm > 0 else 1.0
         return 1.0 if self.scale is None else self.scale
 
 

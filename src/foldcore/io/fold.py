@@ -16,8 +16,10 @@ unknown keys are ignored.
   creases to ∓180° (Origami Simulator's convention; ``Reading(mv_without_angle=
   "passive")`` keeps them passive; :mod:`.conventions`).
 * ``frame_unit`` — every length (coordinates, widths, thickness) is converted
-  to mm: ``unit`` (or absent) and ``mm`` ×1, ``cm`` ×10, ``m`` ×1000,
-  ``in`` ×25.4, ``pt`` ×25.4/72, ``um`` ×1e-3, ``nm`` ×1e-6.
+  to mm: ``mm`` ×1, ``cm`` ×10, ``m`` ×1000, ``in`` ×25.4, ``pt`` ×25.4/72,
+  ``um`` ×1e-3, ``nm`` ×1e-6; ``unit`` (or absent: no unit of length) scales
+  the sheet to 100 mm across unless a size or scale is given
+  (:data:`foldcore.limits.UNITLESS_SHEET_MM`).
 
 foldcore's own keys (lengths in the file's ``frame_unit``; foldcore writes mm):
 
@@ -62,9 +64,8 @@ from ..files import check_input
 from ..hinges import HINGE_MODELS
 from ..pattern import DEFAULT_MAX_ANGLE_DEG, CreasePattern
 from ..planar import Loops, derive_face_loops, freeze, has_repeats, loop_starts, next_in_loop
-from .conventions import (Reading, assigned_angles, crease_pattern_frame, drive_only,
-                          into_plane, note,
-                          PlaneFit, trust_signs)
+from .conventions import (PlaneFit, Reading, assigned_angles, crease_pattern_frame, drive_only,
+                          into_plane, note, trust_signs)
 from .fold_json import (ARRAY, CELLS_KEY, EDGE_STIFFNESS_KEY,  # noqa: F401  (part of this API)
                         FACE_STIFFNESS_KEY, HINGE_KEY, MAX_ANGLE_KEY, POISSON_KEY, TARGET_KEY,
                         THICKNESS_KEY, UNIT_MM, WIDTH_KEY, check_length, fail, has_class, index,
@@ -185,7 +186,13 @@ def _fold_file(d, source: str, reading: Reading | None, owned: bool) -> FoldFile
     faces = _faces(d, len(rows), source)
     vertices = _coords(rows, scale, source, faces, folded)
     del rows
-    factor = reading.factor(_extent(vertices))
+    extent = _extent(vertices)
+    factor = reading.factor(extent, unitless=unit == "unit")
+    if unit == "unit" and reading.size is None and reading.scale is None:
+        declared = "absent" if d.get("frame_unit") is None else "'unit'"
+        note(source, f"no unit of length (frame_unit {declared}): the sheet read as "
+                     f"{limits.UNITLESS_SHEET_MM:g} mm across (1 unit = {factor:.6g} mm); "
+                     "reading.size or reading.scale sets another")
     if factor != 1.0:
         vertices, scale = np.asarray(vertices, dtype=np.float64) * factor, scale * factor
     edges = _edges(d, len(vertices), source)
