@@ -86,12 +86,11 @@ def test_library_call_gives_the_sheet_fold_and_a_thickness_still_gives_a_thick_o
 
 @pytest.mark.parametrize("flag", [["--hinge", "arc"], ["--hinge-width", "1"],
                                   ["--elastic-cells", "5"], ["--solver", "newton"],
-                                  ["--contact", "on"], ["--series", "s.fold"]])
+                                  ["--contact", "on"]])
 def test_options_of_a_thick_sheet_are_refused_before_any_work(miura_file, tmp_path, capsys,
                                                               flag):
     out = tmp_path / "r.fold"
-    args = [a if a != "s.fold" else str(tmp_path / a) for a in flag]
-    assert cli.main(["simulate", str(miura_file), "-o", str(out), *args]) == 2
+    assert cli.main(["simulate", str(miura_file), "-o", str(out), *flag]) == 2
     err = capsys.readouterr().err
     assert f"{flag[0]} is an option of a thick sheet" in err and "Traceback" not in err
     assert not out.exists()
@@ -145,3 +144,39 @@ def test_a_drawings_straight_degree2_vertices_are_left_out_and_said(tmp_path, ca
     ends = [int(np.argmin(np.linalg.norm(np.asarray(pattern.vertices) - p, axis=1)))
             for p in ([50, 0], [50, 100])]
     assert np.allclose(x[middle], 0.6 * x[ends[0]] + 0.4 * x[ends[1]], atol=1e-9)
+
+
+def test_a_series_and_an_animation_fold_the_sheet_frame_by_frame(miura_file, tmp_path):
+    """From flat to 90 % in 4 frames, each from the last: one FOLD frame per percent
+    with its targets (that percent of the file's), its verdict and iterations
+    counted from the start; the last frame is the run's result (-o); a GIF of one
+    picture per frame; the series reads back and opens as a thin result."""
+    from foldcore.result_file import read_result
+
+    series, movie, out = tmp_path / "s.fold", tmp_path / "s.gif", tmp_path / "r.fold"
+    assert cli.main(["simulate", str(miura_file), "--fold-percent", "90", "--frames", "4",
+                     "--series", str(series), "--animate", str(movie), "-o", str(out),
+                     "-q"]) == 0
+    d = json.loads(series.read_text())
+    frames = d["file_frames"]
+    assert d["foldcore:model"] == "sheet"
+    assert [f["foldcore:fold_percent"] for f in frames] == [0.0, 30.0, 60.0, 90.0]
+    assert all(f["foldcore:converged"] for f in frames)
+    steps = [f["foldcore:iterations"] for f in frames]
+    assert steps == sorted(steps) and steps[-1] > steps[1] > 0
+    file_angles = np.asarray(foldcore.io.read(miura_file).fold_angles)
+    largest = []
+    for f in frames:
+        targets = np.array([np.nan if t is None else t for t in f["foldcore:pattern_targetAngle"]])
+        assert np.allclose(targets, f["foldcore:fold_percent"] / 100 * file_angles,
+                           equal_nan=True)
+        largest.append(max(abs(a) for a in f["foldcore:pattern_foldAngle"] if a is not None))
+    assert largest[0] < 1e-9 and np.all(np.diff(largest) > 1.0)  # folding further each frame
+    result = json.loads(out.read_text())["file_frames"][0]["vertices_coords"]
+    assert np.array_equal(frames[-1]["vertices_coords"], result)
+    assert len(read_result(series, thin=True).frames) == 4
+    import imageio.v3 as iio
+
+    pictures = iio.imread(movie, index=None)
+    assert pictures.shape[:3] == (4, 480, 640)
+    assert np.abs(pictures[0].astype(int) - pictures[-1]).sum() > 0  # it moved

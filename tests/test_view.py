@@ -109,6 +109,17 @@ def test_each_colouring_has_its_legend_with_the_scale_it_shows(series, tmp_path,
         assert w.format(a=float(f"{largest:.3g}")).replace(".0\u00b0", "\u00b0") in legend
 
 
+def test_a_thin_sheets_series_shows_a_frame_per_fold_percent(tmp_path):
+    series, page = tmp_path / "wb.fold", tmp_path / "wb.html"
+    assert main(["simulate", "tests/data/real/waterbombBase.svg", "--fold-percent", "90",
+                 "--frames", "3", "--series", str(series), "-q"]) == 0
+    assert main(["view", str(series), "-o", str(page)]) == 0
+    dom = chromium(f"file://{page}", f"--user-data-dir={tmp_path / 'p'}", "--dump-dom").stdout
+    assert 'data-ready="yes"' in dom and 'data-frames="3"' in dom, dom[-500:]
+    flat, folded = (screenshot(page, tmp_path, f"frame={k}") for k in (0, 2))
+    assert np.abs(flat - folded).sum(axis=2).astype(bool).mean() > 0.01  # it moved
+
+
 def test_view_refuses_what_it_cannot_show_in_one_line(tmp_path, capsys):
     pattern = tmp_path / "p.svg"
     pattern.write_text("<svg/>")

@@ -166,10 +166,12 @@ def _fold_thin(job, loaded, on_start, callback) -> Fold:
     from .sheet_job import check_thin, run_thin, thin_settings, thin_summary, write_thin
 
     check_thin(job)
-    sheet, solver, result, interrupted = run_thin(job, loaded, on_start, callback)
+    sheet, solver, result, interrupted, sweep = run_thin(job, loaded, on_start, callback)
+    if sweep is not None:
+        _said_unconverged(sweep)
     summary, settings = thin_summary(job, loaded.pattern, result), thin_settings(job)
     with interrupts_deferred() as late:
-        write_thin(job, loaded.pattern, sheet, result, settings, interrupted)
+        write_thin(job, loaded.pattern, sheet, result, settings, interrupted, sweep)
     if interrupted or late:
         raise Interrupted(result, _written(job.outputs), partial=interrupted)
     return Fold(loaded.pattern, sheet, solver, result, settings, summary)

@@ -48,18 +48,22 @@ def _items(ids: np.ndarray, where: np.ndarray) -> list:
 
 def series_frame(mesh, result, percent: float) -> dict:
     """One frame of a fold-percent series: the folded solid (as :func:`folded_frame`)
-    plus, per edge of the key frame's crease pattern, the achieved angles (within
-    FOLD's [−180°, 180°]) and the effective targets (degrees, null = passive), and
-    the frame's verdict."""
-    frame = folded_frame(mesh, result.positions)
+    and :func:`series_entries`."""
+    return {**folded_frame(mesh, result.positions), **series_entries(result, percent)}
+
+
+def series_entries(result, percent: float) -> dict:
+    """A series frame's keys besides its folded form: its title and fold percent,
+    per edge of the key frame's crease pattern the achieved angles (within FOLD's
+    [−180°, 180°]) and the effective targets (degrees, null = passive), and the
+    frame's verdict (``result``: a thick sheet's Result or a thin one's SheetFold)."""
     targets = result.target_angles_deg
-    frame.update({"frame_title": f"fold percent {percent:g}", SERIES_PERCENT_KEY: percent,
-                  SERIES_ANGLE_KEY: nullable(in_fold_range(result.fold_angles_deg)),
-                  SERIES_TARGET_KEY: None if targets is None else nullable(targets),
-                  "foldcore:converged": bool(result.converged),
-                  "foldcore:reason": result.reason,
-                  "foldcore:iterations": int(result.iterations)})
-    return frame
+    return {"frame_title": f"fold percent {percent:g}", SERIES_PERCENT_KEY: percent,
+            SERIES_ANGLE_KEY: nullable(in_fold_range(result.fold_angles_deg)),
+            SERIES_TARGET_KEY: None if targets is None else nullable(targets),
+            "foldcore:converged": bool(result.converged),
+            "foldcore:reason": result.reason,
+            "foldcore:iterations": int(result.iterations)}
 
 
 def in_fold_range(angles) -> np.ndarray:

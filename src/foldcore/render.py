@@ -340,20 +340,26 @@ class Renderer:
         self._box = [0.0, 1.0, 0.0, 1.0]
         self._title = None
         try:
-            self.panels, self.hinges, self.lines = _surface_parts(
-                mesh, mesh.rest_positions, getattr(pattern, "source", None))
-            self._add_panels()
-            self._add_edges()
-            if scalars is None:
-                self._add_assignment_hinges(legend)
-            else:
-                self._add_scalar_hinges(scalars, scalar_name, cmap, clim)
+            self._add_scene(scalars, scalar_name, cmap, clim, legend)
             self._add_title(title)
         except BaseException:
             self.close()
             raise
 
     # -- scene
+    def _add_scene(self, scalars, scalar_name, cmap, clim, legend):
+        """The solid's surfaces, at rest (:meth:`update` moves them)."""
+        self.panels, self.hinges, self.lines = _surface_parts(
+            self.mesh, self.mesh.rest_positions, getattr(self.pattern, "source", None))
+        self.moving = (self.panels, self.hinges, self.lines)
+        self.n_points = self.mesh.n_vertices
+        self._add_panels()
+        self._add_edges()
+        if scalars is None:
+            self._add_assignment_hinges(legend)
+        else:
+            self._add_scalar_hinges(scalars, scalar_name, cmap, clim)
+
     def _add_panels(self):
         if self.panels is not None:
             behind_lines(self.plotter.add_mesh(self.panels, color=PANEL_COLOUR))
@@ -421,10 +427,10 @@ class Renderer:
     def update(self, positions, scalars=None, title=None) -> None:
         """Move the solid to ``positions`` (N, 3) mm; optionally new scalars / title."""
         x = np.asarray(positions, dtype=float)
-        if x.shape != (self.mesh.n_vertices, 3) or not np.isfinite(x).all():
-            raise RenderError(f"positions must be a finite ({self.mesh.n_vertices}, 3) array "
+        if x.shape != (self.n_points, 3) or not np.isfinite(x).all():
+            raise RenderError(f"positions must be a finite ({self.n_points}, 3) array "
                               f"of mm, got shape {x.shape}")
-        for poly in (self.panels, self.hinges, self.lines):
+        for poly in self.moving:
             if poly is not None:
                 poly.points = x.copy()
         if scalars is not None and self.hinges is not None and "value" in self.hinges.cell_data:
@@ -436,7 +442,7 @@ class Renderer:
     def fit(self, points=None) -> None:
         """Fit the camera to ``points`` (M, 3) mm, default the current solid."""
         if points is None:
-            points = np.vstack([p.points for p in (self.panels, self.hinges) if p is not None])
+            points = np.vstack([p.points for p in self.moving if p is not None])
         w, h = self.size
         fit_camera(self.plotter.camera, points, self.direction, self.up, w / h,
                     self._box, self.padding)

@@ -4,9 +4,11 @@ With no thickness (no ``thickening.thickness``, no ``foldcore:thickness`` in
 the file) :func:`foldcore.simulate` folds the pattern as Origami Simulator
 does: a thin sheet of triangles whose facets bend and stretch a little, its
 creases springs toward their targets (:mod:`foldcore.sheet`), settled to
-equilibrium by Newton's method. One line says so. The options of a thick
-sheet (hinges, strategies, contact, sweeps) have no meaning here: each one
-set is refused, naming it, before any work.
+equilibrium by Newton's method. One line says so. A series or an animation
+folds it from flat through the fold percents of the sweep, each frame from
+the last (:func:`sweep_thin`). The options of a thick sheet (hinges,
+strategies, contact) have no meaning here: each one set is refused, naming
+it, before any work.
 """
 from __future__ import annotations
 
@@ -14,7 +16,7 @@ import time
 import warnings
 
 from .errors import RunWarning
-from .options import OptionError, Outputs, Solving, Thickening
+from .options import OptionError, Solving, Thickening
 
 #: The line a thin-sheet run says first.
 THIN_NOTE = ("no thickness given: folded as a thin sheet (Origami Simulator's model: "
@@ -24,8 +26,7 @@ THIN_NOTE = ("no thickness given: folded as a thin sheet (Origami Simulator's mo
 THICK_ONLY = (("thickening", Thickening, ("hinge_width", "subdivisions", "hinge",
                                           "elastic_cells")),
               ("solving", Solving, ("solver", "actuation", "branch_floor", "strategy_options",
-                                    "contact", "obstacles", "ground")),
-              ("outputs", Outputs, ("animate", "series")))
+                                    "contact", "obstacles", "ground")))
 
 
 def thick_options_set(job) -> list[str]:
@@ -47,9 +48,12 @@ def check_thin(job) -> None:
 
 
 def run_thin(job, loaded, on_start=None, callback=None):
-    """(sheet, solver, result, interrupted): ``job``'s pattern (``loaded``, the file
-    read) folded as a thin sheet. Ctrl-C ends the run with its last iterate
-    (``interrupted`` True, ``result.reason == "interrupted"``)."""
+    """(sheet, solver, result, interrupted, sweep): ``job``'s pattern (``loaded``, the
+    file read) folded as a thin sheet. Ctrl-C ends a single run with its last
+    iterate (``interrupted`` True, ``result.reason == "interrupted"``). With a
+    series or an animation asked for, ``sweep`` is :func:`sweep_thin`'s and the
+    result its last frame (an interrupted sweep writes nothing, as a thick one);
+    else None."""
     from .sheet import SheetSolver, build_sheet
 
     warnings.warn(f"{job.source}: {THIN_NOTE}", RunWarning, stacklevel=3)
@@ -67,13 +71,45 @@ def run_thin(job, loaded, on_start=None, callback=None):
     setup = time.perf_counter() - t0
     if on_start is not None:
         on_start()
-    try:
-        result, interrupted = solver.run(s.tolerance, newton_budget(s),
-                                         _callback(callback)), False
-    except KeyboardInterrupt:
-        result, interrupted = solver.result("interrupted"), True
+    sweep, interrupted = None, False
+    if job.outputs.series or job.outputs.animate:
+        sweep = sweep_thin(job, sheet, pattern)
+        result = sweep[-1][1]
+        result.timings_s["solve"] = sum(r.timings_s["solve"] for _, r in sweep)
+    else:
+        try:
+            result = solver.run(s.tolerance, newton_budget(s), _callback(callback))
+        except KeyboardInterrupt:
+            result, interrupted = solver.result("interrupted"), True
     result.timings_s.update(setup=setup, total=setup + result.timings_s["solve"])
-    return sheet, solver, result, interrupted
+    return sheet, solver, result, interrupted, sweep
+
+
+def sweep_thin(job, sheet, pattern) -> list:
+    """[(fold percent, SheetFold)]: the sheet folded from flat to ``job``'s fold percent
+    in ``outputs.frames`` even steps, each from the last frame's positions (each
+    frame's ``iterations`` counted from the sweep's start, as a thick sweep's); with
+    ``outputs.animate`` the frames rendered (:func:`foldcore.sheet_render.
+    render_sheet_frames`, one camera for all) and written as the animation."""
+    from .animate import percent_schedule, write_animation
+    from .sheet import SheetSolver
+
+    s, out = job.solving, job.outputs
+    sweep, start, steps = [], None, 0
+    for percent in percent_schedule(out.frames, s.fold_percent):
+        fold = SheetSolver(sheet, float(percent), start=start,
+                           pattern_edges=pattern.n_edges).run(s.tolerance, newton_budget(s))
+        steps = fold.iterations = steps + fold.iterations  # from the sweep's start, as thick
+        sweep.append((float(percent), fold))
+        start = fold.positions
+    if out.animate:
+        from .sheet_render import render_sheet_frames
+
+        frames = render_sheet_frames(pattern, sheet.pattern_triangles,
+                                     [f.positions for _, f in sweep],
+                                     titles=[f"fold {p:.4g} %" for p, _ in sweep])
+        write_animation(out.animate, frames, out.fps)
+    return sweep
 
 
 def newton_budget(solving) -> int:
@@ -97,14 +133,17 @@ def thin_summary(job, pattern, result) -> str:
     return summary
 
 
-def write_thin(job, pattern, sheet, result, settings: dict, partial: bool) -> None:
+def write_thin(job, pattern, sheet, result, settings: dict, partial: bool,
+               sweep=None) -> None:
     """The outputs ``job`` asks for (:func:`foldcore.sheet_outputs.write_sheet_result`),
-    ``settings`` (:func:`thin_settings`) recorded in the report."""
+    ``settings`` (:func:`thin_settings`) recorded in the report; ``sweep``: the
+    frames of the series (:func:`run_thin`)."""
     from .sheet_outputs import write_sheet_result
 
     out = job.outputs
     write_sheet_result(result, pattern, sheet, settings, fold_path=out.fold,
-                       report=out.report, png=out.render, partial=partial)
+                       report=out.report, png=out.render, partial=partial,
+                       series=out.series, sweep=sweep)
 
 
 def _callback(callback):

@@ -1,11 +1,13 @@
-"""What a thin-sheet fold writes: the result FOLD, the JSON report, the PNG.
+"""What a thin-sheet fold writes: the result FOLD, the JSON report, the PNG, a series.
 
 The result FOLD is the crease pattern (its ``edges_foldAngle`` the achieved
 angles) with one ``foldedForm`` frame: the pattern's vertices where the sheet
 put them (mm) and the sheet's triangles, each naming the pattern face it cuts
 (``foldcore:faces_face``). The file says ``"foldcore:model": "sheet"`` and has
-no ``foldcore:thickness``. The data files are written all or nothing, the
-picture after them (:func:`foldcore.outputs.write_picture`).
+no ``foldcore:thickness``. A series is the same with one frame per fold
+percent of the sweep, each with the keys of a thick sheet's series frame
+(:func:`foldcore.outputs.series_entries`). The data files are written all or
+nothing, the picture after them (:func:`foldcore.outputs.write_picture`).
 """
 from __future__ import annotations
 
@@ -15,7 +17,7 @@ import numpy as np
 
 from .io.fold_json import MODEL_KEY
 from .outputs import (FACE_PART_KEY, PARTIAL_KEY, actuation_entries, in_fold_range,
-                      machine_entries, nullable, write_picture, write_report)
+                      machine_entries, nullable, series_entries, write_picture, write_report)
 
 MODEL = "sheet"
 
@@ -60,16 +62,22 @@ def sheet_report(fold, pattern, sheet, settings: dict) -> dict:
 
 
 def write_sheet_result(fold, pattern, sheet, settings: dict, *, fold_path=None, report=None,
-                       png=None, partial: bool = False) -> None:
+                       png=None, partial: bool = False, series=None, sweep=None) -> None:
     """Write the outputs asked for (module docstring); None skips one.
 
     ``partial``: the run was interrupted, said in both files as the thick
-    sheet's outputs say it (:func:`foldcore.outputs.write_result`).
+    sheet's outputs say it (:func:`foldcore.outputs.write_result`). ``series``:
+    with ``sweep`` (a list of (fold percent, SheetFold), in order), the series FOLD.
     """
     from .files import all_or_nothing
     from .io import write_fold
 
-    with all_or_nothing({"fold": fold_path, "report": report}) as tmp:
+    with all_or_nothing({"fold": fold_path, "report": report, "series": series}) as tmp:
+        if series:
+            write_fold(tmp["series"], pattern,
+                       achieved_angles=in_fold_range(fold.fold_angles_deg),
+                       frames=[{**sheet_frame(sheet, r.positions), **series_entries(r, p)}
+                               for p, r in sweep], extra={MODEL_KEY: MODEL})
         if fold_path:
             extra = {MODEL_KEY: MODEL, **({PARTIAL_KEY: True} if partial else {})}
             write_fold(tmp["fold"], pattern, achieved_angles=in_fold_range(fold.fold_angles_deg),
@@ -82,5 +90,5 @@ def write_sheet_result(fold, pattern, sheet, settings: dict, *, fold_path=None, 
 
         write_picture(png, lambda path: render_sheet_png(pattern, sheet.pattern_triangles,
                                                          fold.positions, path),
-                      written=[p for p in (fold_path, report) if p])
+                      written=[p for p in (fold_path, report, series) if p])
 

@@ -1,19 +1,54 @@
-"""Offscreen picture of a folded thin sheet (pyvista, imported only inside functions).
+"""Offscreen pictures of a folded thin sheet (pyvista, imported only inside functions).
 
 The sheet's triangles in light grey, its creases drawn over them as lines in
 the assignment colours of :mod:`foldcore.render` (valley blue, mountain red,
 unassigned amber, flat grey) and the boundary in black; the same camera
-presets and orthographic fit as the thick solid's pictures.
+presets, orthographic fit, titles and frames as the thick solid's pictures
+(:class:`SheetRenderer` is a :class:`foldcore.render.Renderer` whose scene is
+the sheet), so an animation of a thin sheet is made as a thick one's is.
 """
 from __future__ import annotations
 
 import numpy as np
 
-from . import files
 from .errors import PatternError
-from .files import ExportError
-from .render import (BACKGROUND, EDGE_COLOUR, HINGE_COLOURS, PANEL_COLOUR, behind_lines,
-                     check_size, fit_camera, require_pyvista, view_vectors)
+from .render import (EDGE_COLOUR, HINGE_COLOURS, PANEL_COLOUR, Renderer, RenderError,
+                     behind_lines, require_pyvista)
+
+
+class SheetRenderer(Renderer):
+    """An offscreen picture of a thin sheet; move it and take frames
+    (:class:`foldcore.render.Renderer`'s ``update``, ``fit``, ``image``, ``save``).
+
+    Parameters
+    ----------
+    pattern : CreasePattern, whose vertices the positions move
+    triangles : (T, 3) int, the sheet's triangles (:class:`foldcore.sheet.Sheet`)
+    size, view, padding, title : as :class:`~foldcore.render.Renderer`
+    """
+
+    def __init__(self, pattern, triangles, size=(1024, 768), view="iso", *,
+                 padding: float = 0.04, title=None):
+        self.triangles = np.asarray(triangles, dtype=np.int64)
+        super().__init__(pattern, None, size, view, padding=padding, title=title)
+
+    def _add_scene(self, scalars, scalar_name, cmap, clim, legend):
+        """The triangles and, over them, the edges in their assignment colours."""
+        pv = require_pyvista()
+        x = np.column_stack([self.pattern.vertices, np.zeros(self.pattern.n_vertices)])
+        faces = np.hstack([np.full((len(self.triangles), 1), 3), self.triangles]).ravel()
+        surface = pv.PolyData(x.copy(), faces)
+        behind_lines(self.plotter.add_mesh(surface, color=PANEL_COLOUR))
+        moving = [surface]
+        kinds = np.asarray(self.pattern.assignments)
+        for kind, colour in {"B": EDGE_COLOUR, **HINGE_COLOURS}.items():
+            edges = np.asarray(self.pattern.edges)[kinds == kind]
+            if len(edges):
+                lines = pv.PolyData(x.copy(),
+                                    lines=np.hstack([np.full((len(edges), 1), 2), edges]).ravel())
+                self.plotter.add_mesh(lines, color=colour, line_width=2 if kind != "B" else 1)
+                moving.append(lines)
+        self.moving, self.n_points = tuple(moving), self.pattern.n_vertices
 
 
 def render_sheet_png(pattern, triangles, positions, path, size=(1024, 768), view="iso",
@@ -30,30 +65,33 @@ def render_sheet_png(pattern, triangles, positions, path, size=(1024, 768), view
     view : {"iso", "top", "front", "side"} or (3,) array, see :mod:`foldcore.render`
     padding : float, margin around the sheet, fraction of its extent
     """
-    size = check_size(size)
-    direction, up = view_vectors(view)
-    pv = require_pyvista()
-    x = np.asarray(positions, dtype=float)
-    faces = np.hstack([np.full((len(triangles), 1), 3), triangles]).ravel()
-    plotter = pv.Plotter(off_screen=True, window_size=list(size))
-    try:
-        plotter.set_background(BACKGROUND)
-        behind_lines(plotter.add_mesh(pv.PolyData(x, faces), color=PANEL_COLOUR))
-        kinds = np.asarray(pattern.assignments)
-        for kind, colour in {"B": EDGE_COLOUR, **HINGE_COLOURS}.items():
-            edges = np.asarray(pattern.edges)[kinds == kind]
-            if len(edges):
-                lines = np.hstack([np.full((len(edges), 1), 2), edges]).ravel()
-                plotter.add_mesh(pv.PolyData(x, lines=lines), color=colour,
-                                 line_width=2 if kind != "B" else 1)
-        fit_camera(plotter.camera, x, direction, up, size[0] / size[1], (0.0, 1.0, 0.0, 1.0),
-                   padding)
-        files.check_folder(path, ExportError)
-        plotter.render()
-        with files.atomic_path(path, suffix=".png") as tmp:
-            plotter.screenshot(tmp)
-    finally:
-        plotter.close()
+    with SheetRenderer(pattern, triangles, size, view, padding=padding) as r:
+        r.update(positions)
+        r.fit()
+        r.save(path)
+
+
+def render_sheet_frames(pattern, triangles, positions, *, size=(640, 480), view="iso",
+                        titles=None) -> list:
+    """Each of ``positions`` ((N, 3) mm, one list entry per frame) rendered with one
+    camera fitted to all of them (as :func:`foldcore.animate.render_frames`);
+    ``titles``: text in the upper-left corner of each. A list of (height, width, 3)
+    uint8."""
+    positions = [np.asarray(p, dtype=float) for p in positions]
+    if not positions:
+        raise RenderError("no frames to render")
+    titles = None if titles is None else list(titles)
+    if titles is not None and len(titles) != len(positions):
+        raise RenderError(f"{len(titles)} titles for {len(positions)} frames")
+    frames = []
+    with SheetRenderer(pattern, triangles, size, view,
+                       title=titles[0] if titles else None) as r:
+        r.update(positions[0])
+        r.fit(np.vstack(positions))
+        for i, x in enumerate(positions):
+            r.update(x, title=None if titles is None else titles[i])
+            frames.append(r.image())
+    return frames
 
 
 def render_sheet_result(result, path, size=(1024, 768), view="iso",
