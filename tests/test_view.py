@@ -118,6 +118,22 @@ def test_a_thin_sheets_series_shows_a_frame_per_fold_percent(tmp_path):
     assert 'data-ready="yes"' in dom and 'data-frames="3"' in dom, dom[-500:]
     flat, folded = (screenshot(page, tmp_path, f"frame={k}") for k in (0, 2))
     assert np.abs(flat - folded).sum(axis=2).astype(bool).mean() > 0.01  # it moved
+    strained = chromium(f"file://{page}#colour=strain", f"--user-data-dir={tmp_path / 'q'}",
+                        "--dump-dom").stdout
+    assert "largest side strain of each facet: 0" in strained
+
+
+def test_a_facets_strain_is_its_largest_side_strain_against_the_flat_sheet():
+    """A right triangle (legs 10 mm) stretched 1 % along x and pressed 2 % along y:
+    the legs strain by 0.01 and 0.02, the hypotenuse by less; a degenerate facet's
+    strain is bounded, not infinite."""
+    from foldcore.pattern import CreasePattern
+    from foldcore.view import MAX_SHOWN_STRAIN, facet_strains
+
+    pattern = CreasePattern([(0, 0), (10, 0), (0, 10)], [(0, 1), (1, 2), (2, 0)], "BBB")
+    moved = np.array([[0, 0, 0], [10.1, 0, 0], [0, 9.8, 0]])
+    assert facet_strains(pattern, np.array([[0, 1, 2]]), moved) == pytest.approx([0.02])
+    assert facet_strains(pattern, np.array([[0, 0, 2]]), moved)[0] <= MAX_SHOWN_STRAIN
 
 
 def test_view_refuses_what_it_cannot_show_in_one_line(tmp_path, capsys):

@@ -15,8 +15,9 @@ chooses the first view (used by the tests). Geometry: the outer surface of
 the thick mesh rebuilt from the file (:func:`foldcore.result_file.read_result`),
 float32 positions per frame, base64-encoded. A thin sheet's result (no
 thickness) shows its folded triangles as grey facets with its creases drawn
-over them as lines, coloured by assignment or by their angle (it has no hinge
-strips to strain).
+over them as lines, coloured by assignment or by their angle, or its facets
+coloured by strain (each triangle's largest side strain against the flat
+sheet, as Origami Simulator colours its strain).
 
 Nothing from the file becomes markup or script: the values are those
 ``read_result`` checked (types, shapes, ranges), they reach the page only as
@@ -78,26 +79,53 @@ def view_html(path, output) -> None:
     strip = np.where(bending, surface.element[face], -1).astype(np.int32)
     data = {"triangles": _b64(triangles.astype("<u4")), "kind": _b64(kind),
             "crease": _b64(crease.astype("<i4")), "strip": _b64(strip),
+            "strain_label": STRAIN_LABELS["thick"],
             "frames": [_page_frame(frame, res.mesh) for frame in res.frames]}
     write_text(output, _page(source, data))
 
 
+#: What the strain colouring shows, per kind of result (the page's legend).
+STRAIN_LABELS = {"thick": "largest surface strain of each hinge sub-strip",
+                 "thin": "largest side strain of each facet"}
+#: Strains are shown up to this (a degenerate facet's would be unbounded).
+MAX_SHOWN_STRAIN = 1e6
+
+
 def _sheet_data(res) -> dict:
     """The page's data of a thin sheet's result: its triangles, all facets (kind 0,
-    no crease or strip); its pattern's edges as lines (``lines``, ``line_kind``: 0
-    boundary, else as :data:`KINDS`, ``line_crease``: the edge, −1 on the boundary)
-    drawn over them; per frame its positions, no strains and its angles."""
+    no crease; each triangle its own ``strip``, coloured by its strain); its
+    pattern's edges as lines (``lines``, ``line_kind``: 0 boundary, else as
+    :data:`KINDS`, ``line_crease``: the edge, −1 on the boundary) drawn over them;
+    per frame its positions, its facets' strains (:func:`facet_strains`) and its
+    angles."""
     count = len(res.triangles)
-    none = np.full(count, -1, dtype="<i4")
     kinds = [str(k) for k in res.pattern.assignments]
     line_kind = np.array([0 if k == "B" else KINDS.get(k, 4) for k in kinds], dtype=np.uint8)
     line_crease = np.where(line_kind > 0, np.arange(len(kinds)), -1).astype("<i4")
     return {"triangles": _b64(res.triangles.astype("<u4")),
-            "kind": _b64(np.zeros(count, dtype=np.uint8)), "crease": _b64(none),
-            "strip": _b64(none),
+            "kind": _b64(np.zeros(count, dtype=np.uint8)),
+            "crease": _b64(np.full(count, -1, dtype="<i4")),
+            "strip": _b64(np.arange(count, dtype="<i4")), "strain_label": STRAIN_LABELS["thin"],
             "lines": _b64(np.asarray(res.pattern.edges, dtype="<u4")),
             "line_kind": _b64(line_kind), "line_crease": _b64(line_crease),
-            "frames": [_frame_entry(frame, np.zeros(0)) for frame in res.frames]}
+            "frames": [_frame_entry(frame, facet_strains(res.pattern, res.triangles,
+                                                         frame.positions))
+                       for frame in res.frames]}
+
+
+def facet_strains(pattern, triangles: np.ndarray, positions: np.ndarray) -> np.ndarray:
+    """(T,) the largest |L − L₀| / L₀ of each triangle's three sides (dimensionless),
+    L₀ in the flat ``pattern``, L at ``positions`` (N, 3) mm; at most
+    :data:`MAX_SHOWN_STRAIN`."""
+    flat = np.column_stack([pattern.vertices, np.zeros(pattern.n_vertices)])
+    t = np.asarray(triangles)
+    ends = (t, np.roll(t, -1, axis=1))
+    rest = np.linalg.norm(flat[ends[1]] - flat[ends[0]], axis=2)
+    now = np.linalg.norm(positions[ends[1]] - positions[ends[0]], axis=2)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        strain = np.abs(now - rest) / rest
+    return np.minimum(np.nan_to_num(strain, nan=0.0, posinf=MAX_SHOWN_STRAIN),
+                      MAX_SHOWN_STRAIN).max(axis=1, initial=0.0)
 
 
 def _page(source: str, data: dict) -> str:
