@@ -45,6 +45,8 @@ OPTIONS = {  # option: values drawn for it
     "--subdivisions": COUNTS, "--max-iterations": COUNTS, "--frames": COUNTS,
     "--solver": ["rigid", "hybrid", "newton", "paper", "lbfgs", "anderson", "x"],
     "--hinge": ["axis", "arc", "slack", "eq8", "x"], "--contact": ["on", "off", "x"],
+    "--drive": ["0", "1", "0,1", "1-3", "3-1", "-1", "x", "", "0-999999999999",
+                "999999999999", "1,,2", "0-1000000"],
 }
 OUTPUTS = ["out.fold", "", "sub/none/out.fold", "x" * 300 + ".fold", ".", "out.txt"]
 
