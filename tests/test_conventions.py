@@ -258,3 +258,23 @@ def test_drive_refuses_an_edge_it_cannot_drive_naming_it(drive, words):
 def test_drive_is_a_non_empty_list_of_edge_ids(drive):
     with pytest.raises(ValueError, match="drive"):
         Reading(drive=drive)
+
+
+@pytest.mark.parametrize("suffix", [".svg", ".cp"])
+def test_drive_applies_to_drawings_and_line_files_as_read(tmp_path, suffix):
+    """The ids are the pattern's as read (an SVG's in Origami Simulator's order)."""
+    from foldcore.io import read_file
+
+    if suffix == ".svg":
+        path = "tests/data/real/waterbombBase.svg"
+    else:  # a square with its two diagonals: valley and mountain (ORIPA types 3, 2)
+        path = tmp_path / "x.cp"
+        path.write_text("1 0 0 10 0\n1 10 0 10 10\n1 10 10 0 10\n1 0 10 0 0\n"
+                        "3 0 0 10 10\n2 10 0 0 10\n")
+    every = read_file(path).pattern
+    driven = np.flatnonzero(~np.isnan(every.fold_angles))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", PatternWarning)
+        one = read_file(path, reading=Reading(drive=[int(driven[-1])])).pattern
+    assert np.flatnonzero(~np.isnan(one.fold_angles)).tolist() == [int(driven[-1])]
+    assert one.fold_angles[driven[-1]] == every.fold_angles[driven[-1]]
