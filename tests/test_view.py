@@ -150,8 +150,9 @@ def test_a_thin_sheets_result_shows_its_folded_triangles(tmp_path):
     """A result folded with no thickness (the thin sheet) has no thick mesh to rebuild:
     ``view`` shows its folded triangles (grey facets, the creases drawn over them in
     their M/V colours) and ``render`` draws them with the creases in their colours,
-    instead of refusing it; ``render --color-by`` (a thick sheet's strips) still says
-    it needs a thick result."""
+    instead of refusing it; ``render --color-by angle`` colours the creases (valley
+    blue, mountain red), ``strain`` the facets with a colour bar, and ``strip-angle``
+    (a thick sheet's sub-strips) is refused."""
     result, page = tmp_path / "wb.fold", tmp_path / "wb.html"
     assert main(["simulate", "tests/data/real/waterbombBase.svg", "--fold-percent", "80",
                  "-o", str(result), "-q"]) == 0
@@ -166,8 +167,16 @@ def test_a_thin_sheets_result_shows_its_folded_triangles(tmp_path):
     assert main(["render", str(result), "-o", str(picture), "--size", "320x240"]) == 0
     drawn = screenshot_of(picture)
     assert count(drawn, "red") > 0 and count(drawn, "blue") > 0  # the M/V creases
+    angles, strains = tmp_path / "angle.png", tmp_path / "strain.png"
+    assert main(["render", str(result), "-o", str(angles), "--color-by", "angle"]) == 0
+    drawn = screenshot_of(angles)
+    assert count(drawn, "red") > 0 and count(drawn, "blue") > 0  # mountains, valleys
+    assert main(["render", str(result), "-o", str(strains), "--color-by", "strain"]) == 0
+    drawn = screenshot_of(strains)
+    viridis_top = (drawn[..., 0] > 200) & (drawn[..., 1] > 200) & (drawn[..., 2] < 80)
+    assert viridis_top.sum() > 0  # the colour bar's (and the most strained facet's) yellow
     assert main(["render", str(result), "-o", str(tmp_path / "no.png"),
-                 "--color-by", "strain"]) == 2
+                 "--color-by", "strip-angle"]) == 2
     assert not (tmp_path / "no.png").exists()
 
 

@@ -307,7 +307,8 @@ def _add_render(sub) -> None:
                      choices=("angle", "strip-angle", "strain", "none"),
                      help="hinge colours: mountain/valley (none, default), each crease's fold "
                           "angle (angle) or each sub-strip's bend angle (strip-angle), degrees, "
-                          "or each sub-strip's largest surface tension (strain)")
+                          "or each sub-strip's largest surface tension (strain); a thin "
+                          "sheet: its creases by angle, its facets by side strain (strain)")
     _add_rebuild_options(ren)
 
 

@@ -394,14 +394,19 @@ class Renderer:
             return
         self.clim = tuple(float(c) for c in (clim or colour_limits(strips)))
         self.hinges.cell_data["value"] = self._strip_cells(strips)
+        behind_lines(self.add_scalars(self.hinges, name, cmap))
+
+    def add_scalars(self, poly, name: str, cmap, **options):
+        """Add ``poly`` coloured by its cell data ``value`` within :attr:`clim`, with a
+        horizontal colour bar titled ``name`` at the bottom; the actor."""
         bar = dict(title=name, color="black", vertical=False, position_x=0.2,
                    position_y=0.03, width=0.6, height=0.09, n_labels=5, fmt="%.3g",
                    title_font_size=self._font(18), label_font_size=self._font(16),
                    unconstrained_font_size=True)
-        behind_lines(self.plotter.add_mesh(
-            self.hinges, scalars="value", cmap=cmap or default_cmap(self.clim), clim=self.clim,
-            nan_color=(0.5, 0.5, 0.5), scalar_bar_args=bar))
         self._box[2] = _BAR_STRIP
+        return self.plotter.add_mesh(poly, scalars="value", cmap=cmap or default_cmap(self.clim),
+                                     clim=self.clim, nan_color=(0.5, 0.5, 0.5),
+                                     scalar_bar_args=bar, **options)
 
     def _strip_cells(self, strips: np.ndarray) -> np.ndarray:
         """Per-cell values of the hinge surface: bending sub-strips take theirs, other

@@ -13,7 +13,7 @@ import numpy as np
 
 from .errors import PatternError
 from .render import (EDGE_COLOUR, HINGE_COLOURS, PANEL_COLOUR, Renderer, RenderError,
-                     behind_lines, require_pyvista)
+                     behind_lines, colour_limits, require_pyvista)
 
 
 class SheetRenderer(Renderer):
@@ -25,34 +25,66 @@ class SheetRenderer(Renderer):
     pattern : CreasePattern, whose vertices the positions move
     triangles : (T, 3) int, the sheet's triangles (:class:`foldcore.sheet.Sheet`)
     size, view, padding, title : as :class:`~foldcore.render.Renderer`
+    facets, creases : (T,) or (E,) float, optional
+        Colour the triangles by ``facets`` (e.g. their strain), or the creases by
+        ``creases`` (one per pattern edge, e.g. fold angles in degrees; the
+        boundary stays black), with a colour bar titled ``scalar_name``; default
+        the assignment colours. ``cmap`` and ``clim`` as the Renderer's.
     """
 
-    def __init__(self, pattern, triangles, size=(1024, 768), view="iso", *,
+    def __init__(self, pattern, triangles, size=(1024, 768), view="iso", *, facets=None,
+                 creases=None, scalar_name="value", cmap=None, clim=None,
                  padding: float = 0.04, title=None):
         self.triangles = np.asarray(triangles, dtype=np.int64)
-        super().__init__(pattern, None, size, view, padding=padding, title=title)
+        self.values = {"facets": facets, "creases": creases}
+        super().__init__(pattern, None, size, view, scalar_name=scalar_name, cmap=cmap,
+                         clim=clim, padding=padding, title=title)
 
     def _add_scene(self, scalars, scalar_name, cmap, clim, legend):
-        """The triangles and, over them, the edges in their assignment colours."""
+        """The triangles and, over them, the edges in their assignment colours (or
+        either coloured by values, with a colour bar)."""
         pv = require_pyvista()
         x = np.column_stack([self.pattern.vertices, np.zeros(self.pattern.n_vertices)])
         faces = np.hstack([np.full((len(self.triangles), 1), 3), self.triangles]).ravel()
         surface = pv.PolyData(x.copy(), faces)
-        behind_lines(self.plotter.add_mesh(surface, color=PANEL_COLOUR))
-        moving = [surface]
+        facets, creases = self.values["facets"], self.values["creases"]
+        shown = facets if facets is not None else creases
+        if shown is not None:
+            self.clim = tuple(float(c) for c in (clim or colour_limits(shown)))
+        if facets is not None:
+            surface.cell_data["value"] = np.asarray(facets, dtype=float)
+            behind_lines(self.add_scalars(surface, scalar_name, cmap))
+        else:
+            behind_lines(self.plotter.add_mesh(surface, color=PANEL_COLOUR))
+        lines = self._add_edges_of(pv, x, creases, scalar_name, cmap)
+        self.moving, self.n_points = (surface, *lines), self.pattern.n_vertices
+
+    def _add_edges_of(self, pv, x, creases, name, cmap) -> list:
+        """The pattern's edges as lines, by assignment colour, or its creases by
+        ``creases`` (the boundary black); the PolyData added."""
         kinds = np.asarray(self.pattern.assignments)
-        for kind, colour in {"B": EDGE_COLOUR, **HINGE_COLOURS}.items():
-            edges = np.asarray(self.pattern.edges)[kinds == kind]
-            if len(edges):
-                lines = pv.PolyData(x.copy(),
-                                    lines=np.hstack([np.full((len(edges), 1), 2), edges]).ravel())
+        edges = np.asarray(self.pattern.edges)
+        groups = {"B": EDGE_COLOUR, **HINGE_COLOURS} if creases is None else {"B": EDGE_COLOUR,
+                                                                            "creases": None}
+        added = []
+        for kind, colour in groups.items():
+            chosen = kinds == "B" if kind == "B" else (kinds != "B" if creases is not None
+                                                       else kinds == kind)
+            if not chosen.any():
+                continue
+            lines = pv.PolyData(x.copy(), lines=np.hstack(
+                [np.full((int(chosen.sum()), 1), 2), edges[chosen]]).ravel())
+            if colour is None:
+                lines.cell_data["value"] = np.asarray(creases, dtype=float)[chosen]
+                self.add_scalars(lines, name, cmap, line_width=3)
+            else:
                 self.plotter.add_mesh(lines, color=colour, line_width=2 if kind != "B" else 1)
-                moving.append(lines)
-        self.moving, self.n_points = tuple(moving), self.pattern.n_vertices
+            added.append(lines)
+        return added
 
 
 def render_sheet_png(pattern, triangles, positions, path, size=(1024, 768), view="iso",
-                     padding: float = 0.04) -> None:
+                     padding: float = 0.04, **colouring) -> None:
     """Render the thin sheet at ``positions`` to a PNG file, offscreen, atomically.
 
     Parameters
@@ -64,8 +96,10 @@ def render_sheet_png(pattern, triangles, positions, path, size=(1024, 768), view
     size : (int, int), width and height in pixels
     view : {"iso", "top", "front", "side"} or (3,) array, see :mod:`foldcore.render`
     padding : float, margin around the sheet, fraction of its extent
+    colouring : ``facets`` or ``creases`` values and their ``scalar_name``,
+        ``cmap``, ``clim`` (:class:`SheetRenderer`); default assignment colours
     """
-    with SheetRenderer(pattern, triangles, size, view, padding=padding) as r:
+    with SheetRenderer(pattern, triangles, size, view, padding=padding, **colouring) as r:
         r.update(positions)
         r.fit()
         r.save(path)
@@ -98,17 +132,32 @@ def render_sheet_result(result, path, size=(1024, 768), view="iso",
                         color_by: str = "none") -> None:
     """``foldcore render`` of a thin sheet's result file (a
     :class:`~foldcore.result_file.SheetResultFile`): its last folded frame's
-    triangles, creases in their assignment colours (:func:`render_sheet_png`).
+    triangles (:func:`render_sheet_png`), creases in their assignment colours
+    (``none``), or coloured by their fold angle (``angle``: degrees, valley > 0
+    blue), or the facets by their strain (``strain``: each triangle's largest side
+    strain against the flat sheet, :func:`foldcore.view.facet_strains`).
 
     Raises
     ------
     PatternError
-        ``color_by`` other than "none": the colourings are of a thick sheet's
-        hinge strips, which a thin sheet has not.
+        ``strip-angle``: a thick sheet's sub-strips, which a thin sheet has not.
     """
-    if color_by != "none":
+    frame = result.frames[-1]
+    if color_by == "strain":
+        from .view import facet_strains
+
+        values = facet_strains(result.pattern, result.triangles, frame.positions)
+        colouring = dict(facets=values, clim=colour_limits(values, signed=False),
+                         cmap="viridis", scalar_name="facet strain (largest side)")
+    elif color_by == "angle":
+        colouring = dict(creases=frame.angles, cmap="RdBu", scalar_name="fold angle (deg)",
+                         clim=colour_limits(frame.angles[np.isfinite(frame.angles)],
+                                            signed=True))
+    elif color_by != "none":
         raise PatternError(f"{result.source}: --color-by {color_by} colours a thick sheet's "
-                           "hinge strips; a thin sheet's result is drawn with its creases "
-                           "in their assignment colours (--color-by none)")
-    render_sheet_png(result.pattern, result.triangles, result.frames[-1].positions, path,
-                     size=size, view=view)
+                           "hinge sub-strips; a thin sheet's result takes none, angle or "
+                           "strain")
+    else:
+        colouring = {}
+    render_sheet_png(result.pattern, result.triangles, frame.positions, path, size=size,
+                     view=view, **colouring)
