@@ -563,5 +563,6 @@ def _log_to_stderr(verbosity: int):
     return handler
 
 
-if __name__ == "__main__":  # pragma: no cover
-    sys.exit(main())
+if __name__ == "__main__":  # pragma: no cover  (python -m foldcore.cli: as python -m foldcore)
+    from .__main__ import run
+    sys.exit(run())
