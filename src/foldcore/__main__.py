@@ -10,15 +10,14 @@ import sys
 
 def run() -> int:
     """The ``foldcore`` command: :func:`foldcore.cli.main` with signals handled from
-    the start to the exit; the exit code."""
-    from .interrupts import finished, starting
+    the start to the exit (its import included); the exit code."""
+    from .interrupts import run_command
 
-    starting()
-    from .cli import main
+    def command() -> int:
+        from .cli import main
+        return main()
 
-    code = main()
-    finished()
-    return code
+    return run_command(command)
 
 
 if __name__ == "__main__":

@@ -564,5 +564,4 @@ def _log_to_stderr(verbosity: int):
 
 
 if __name__ == "__main__":  # pragma: no cover  (python -m foldcore.cli: as python -m foldcore)
-    from .__main__ import run
-    sys.exit(run())
+    sys.exit(interrupts.run_command(main))

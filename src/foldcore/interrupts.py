@@ -53,6 +53,16 @@ def finished() -> None:
         signal.signal(number, signal.SIG_IGN)
 
 
+def run_command(command) -> int:
+    """``command()`` (the command line, or a function that imports and runs it) with
+    signals handled from before it starts (:func:`starting`) to after it ends
+    (:func:`finished`); its exit code."""
+    starting()
+    code = command()
+    finished()
+    return code
+
+
 _received: list = []  # the signals :func:`handled` turned into exceptions, in order
 
 
