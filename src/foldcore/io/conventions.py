@@ -106,12 +106,19 @@ class Reading:
                                  f"≥ 0), got {self.drive!r}")
             object.__setattr__(self, "drive", tuple(int(e) for e in ids))
 
-    def factor(self, extent_mm: float, unitless: bool = False) -> float:
-        """The factor every length is multiplied by, for a sheet ``extent_mm`` wide;
-        ``unitless``: the file declares no unit of length, so without a size or a
-        scale its larger extent becomes :data:`UNITLESS_SHEET_MM`."""
-        if self.size is not None or (unitless and self.scale is None):
-            size = UNITLESS_SHEET_MM if self.size is None else self.size
+    def unitless_size(self, unit: str) -> float | None:
+        """The sheet's larger extent, mm, that a file of ``unit`` gets by default:
+        :data:`UNITLESS_SHEET_MM` when it declares no unit of length (``"unit"``) and
+        neither a size nor a scale is given; else None."""
+        given = self.size is not None or self.scale is not None
+        return UNITLESS_SHEET_MM if unit == "unit" and not given else None
+
+    def factor(self, extent_mm: float, default_size: float | None = None) -> float:
+        """The factor every length is multiplied by, for a sheet ``extent_mm`` wide:
+        to :attr:`size` (or ``default_size``, :meth:`unitless_size`) when there is
+        one, else :attr:`scale` (default 1)."""
+        size = self.size if self.size is not None else default_size
+        if size is not None:
             return size / extent_mm if extent_mm > 0 else 1.0
         return 1.0 if self.scale is None else self.scale
 

@@ -186,12 +186,12 @@ def _fold_file(d, source: str, reading: Reading | None, owned: bool) -> FoldFile
     faces = _faces(d, len(rows), source)
     vertices = _coords(rows, scale, source, faces, folded)
     del rows
-    extent = _extent(vertices)
-    factor = reading.factor(extent, unitless=unit == "unit")
-    if unit == "unit" and reading.size is None and reading.scale is None:
+    default_size = reading.unitless_size(unit)
+    factor = reading.factor(_extent(vertices), default_size)
+    if default_size is not None:
         declared = "absent" if d.get("frame_unit") is None else "'unit'"
         note(source, f"no unit of length (frame_unit {declared}): the sheet read as "
-                     f"{limits.UNITLESS_SHEET_MM:g} mm across (1 unit = {factor:.6g} mm); "
+                     f"{default_size:g} mm across (1 unit = {factor:.6g} mm); "
                      "reading.size or reading.scale sets another")
     if factor != 1.0:
         vertices, scale = np.asarray(vertices, dtype=np.float64) * factor, scale * factor
