@@ -115,13 +115,13 @@ def read_svg(path, reading: Reading | None = None, with_drawn: bool = False):
     check_meetings(segments, source)
     segments[:, :, 1] *= -1.0  # SVG y points down
     extent = float(np.ptp(segments.reshape(-1, 2), axis=0).max())
-    read = pattern_from_lines(segments, kinds, angles, owners, source,
-                              tol=min(SNAP_PX, SNAP_MAX * extent),
-                              factor=reading.factor(extent * MM_PER_PX) * MM_PER_PX,
-                              where=lambda x, y: f"({x:g}, {-y:g}) px",
-                              sides_as_origami_simulator=True, numbering=numbering,
-                              with_drawn=True)
-    pattern, drawn = drive_only(read[0], reading.drive, source), read[1]
+    pattern, drawn = pattern_from_lines(segments, kinds, angles, owners, source,
+                                        tol=min(SNAP_PX, SNAP_MAX * extent),
+                                        factor=reading.factor(extent * MM_PER_PX) * MM_PER_PX,
+                                        where=lambda x, y: f"({x:g}, {-y:g}) px",
+                                        sides_as_origami_simulator=True, numbering=numbering,
+                                        with_drawn=True)
+    pattern = drive_only(pattern, reading.drive, source)
     return (pattern, drawn) if with_drawn else pattern
 
 
