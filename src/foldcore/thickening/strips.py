@@ -55,8 +55,13 @@ def short_creases(pattern, corners) -> np.ndarray:
     lengths = pattern.edge_lengths()
     out = np.zeros(pattern.n_edges, dtype=bool)
     for e in pattern.creases:
-        out[e] = sum(_strip_cuts(pattern, e, corners, place)) >= lengths[e] * (1 - 1e-9)
+        out[e] = _cut_away(_strip_cuts(pattern, e, corners, place), lengths[e])
     return out
+
+
+def _cut_away(cuts: tuple[float, float], length: float) -> bool:
+    """Whether a crease ``length`` mm long keeps no strip between its end ``cuts`` (mm)."""
+    return cuts[0] + cuts[1] >= length * (1 - 1e-9)
 
 
 def _strip_cuts(pattern, e, corners, place) -> tuple[float, float]:
@@ -82,7 +87,7 @@ def _strip_lines(pattern, e, width, k, cuts, segments: int = 1):
     a, b = pattern.edges[e]
     pa, pb = pattern.vertices[a], pattern.vertices[b]
     length = vector_length(pb - pa)
-    if cuts[0] + cuts[1] >= length * (1 - 1e-9):
+    if _cut_away(cuts, length):
         raise MeshError(f"{pattern.source}: edge {e} ({length:.6g} mm) is too short for the "
                         "hinge widths around it; use narrower hinges")
     u = (pb - pa) / length
