@@ -128,7 +128,7 @@ def test_a_facets_strain_is_its_largest_side_strain_against_the_flat_sheet():
     the legs strain by 0.01 and 0.02, the hypotenuse by less; a degenerate facet's
     strain is bounded, not infinite."""
     from foldcore.pattern import CreasePattern
-    from foldcore.view import MAX_SHOWN_STRAIN, facet_strains
+    from foldcore.measure import MAX_SHOWN_STRAIN, facet_strains
 
     pattern = CreasePattern([(0, 0), (10, 0), (0, 10)], [(0, 1), (1, 2), (2, 0)], "BBB")
     moved = np.array([[0, 0, 0], [10.1, 0, 0], [0, 9.8, 0]])

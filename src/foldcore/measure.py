@@ -1,4 +1,5 @@
-"""Measurements on a deformed thick mesh: panel rotations and fold angles.
+"""Measurements on a deformed thick mesh: panel rotations and fold angles; and a thin
+sheet's facet strains (:func:`facet_strains`).
 
 Fold angle of a crease = signed dihedral between the mid-planes of its two
 panels, valley positive (FOLD), measured from panel geometry, not from hinges.
@@ -143,3 +144,21 @@ def _depth_into(positions, panel_ids, hinge_ids, rotation, points, half) -> floa
     if not chosen.any():
         return 0.0
     return float((half - np.abs(height[chosen])).max())
+
+
+#: Facet strains are reported up to this (a degenerate facet's would be unbounded).
+MAX_SHOWN_STRAIN = 1e6
+
+
+def facet_strains(pattern, triangles: np.ndarray, positions: np.ndarray) -> np.ndarray:
+    """(T,) the largest |L − L₀| / L₀ of each triangle's three sides (dimensionless),
+    L₀ in the flat ``pattern``, L at ``positions`` (N, 3) mm; at most
+    :data:`MAX_SHOWN_STRAIN`."""
+    t = np.asarray(triangles)
+    ends = (t, np.roll(t, -1, axis=1))
+    rest = np.linalg.norm(pattern.vertices[ends[1]] - pattern.vertices[ends[0]], axis=2)
+    now = np.linalg.norm(positions[ends[1]] - positions[ends[0]], axis=2)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        strain = np.abs(now - rest) / rest
+    return np.minimum(np.nan_to_num(strain, nan=0.0, posinf=MAX_SHOWN_STRAIN),
+                      MAX_SHOWN_STRAIN).max(axis=1, initial=0.0)

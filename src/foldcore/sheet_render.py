@@ -135,7 +135,7 @@ def render_sheet_result(result, path, size=(1024, 768), view="iso",
     triangles (:func:`render_sheet_png`), creases in their assignment colours
     (``none``), or coloured by their fold angle (``angle``: degrees, valley > 0
     blue), or the facets by their strain (``strain``: each triangle's largest side
-    strain against the flat sheet, :func:`foldcore.view.facet_strains`).
+    strain against the flat sheet, :func:`foldcore.measure.facet_strains`).
 
     Raises
     ------
@@ -144,7 +144,7 @@ def render_sheet_result(result, path, size=(1024, 768), view="iso",
     """
     frame = result.frames[-1]
     if color_by == "strain":
-        from .view import facet_strains
+        from .measure import facet_strains
 
         values = facet_strains(result.pattern, result.triangles, frame.positions)
         colouring = dict(facets=values, clim=colour_limits(values, signed=False),

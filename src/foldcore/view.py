@@ -87,8 +87,6 @@ def view_html(path, output) -> None:
 #: What the strain colouring shows, per kind of result (the page's legend).
 STRAIN_LABELS = {"thick": "largest surface strain of each hinge sub-strip",
                  "thin": "largest side strain of each facet"}
-#: Strains are shown up to this (a degenerate facet's would be unbounded).
-MAX_SHOWN_STRAIN = 1e6
 
 
 def _sheet_data(res) -> dict:
@@ -96,8 +94,10 @@ def _sheet_data(res) -> dict:
     no crease; each triangle its own ``strip``, coloured by its strain); its
     pattern's edges as lines (``lines``, ``line_kind``: 0 boundary, else as
     :data:`KINDS`, ``line_crease``: the edge, −1 on the boundary) drawn over them;
-    per frame its positions, its facets' strains (:func:`facet_strains`) and its
-    angles."""
+    per frame its positions, its facets' strains
+    (:func:`foldcore.measure.facet_strains`) and its angles."""
+    from .measure import facet_strains
+
     count = len(res.triangles)
     kinds = [str(k) for k in res.pattern.assignments]
     line_kind = np.array([0 if k == "B" else KINDS.get(k, 4) for k in kinds], dtype=np.uint8)
@@ -111,21 +111,6 @@ def _sheet_data(res) -> dict:
             "frames": [_frame_entry(frame, facet_strains(res.pattern, res.triangles,
                                                          frame.positions))
                        for frame in res.frames]}
-
-
-def facet_strains(pattern, triangles: np.ndarray, positions: np.ndarray) -> np.ndarray:
-    """(T,) the largest |L − L₀| / L₀ of each triangle's three sides (dimensionless),
-    L₀ in the flat ``pattern``, L at ``positions`` (N, 3) mm; at most
-    :data:`MAX_SHOWN_STRAIN`."""
-    flat = np.column_stack([pattern.vertices, np.zeros(pattern.n_vertices)])
-    t = np.asarray(triangles)
-    ends = (t, np.roll(t, -1, axis=1))
-    rest = np.linalg.norm(flat[ends[1]] - flat[ends[0]], axis=2)
-    now = np.linalg.norm(positions[ends[1]] - positions[ends[0]], axis=2)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        strain = np.abs(now - rest) / rest
-    return np.minimum(np.nan_to_num(strain, nan=0.0, posinf=MAX_SHOWN_STRAIN),
-                      MAX_SHOWN_STRAIN).max(axis=1, initial=0.0)
 
 
 def _page(source: str, data: dict) -> str:
