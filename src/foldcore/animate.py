@@ -172,9 +172,7 @@ def render_frames(pattern, mesh, positions, *, size=(640, 480), view="iso", scal
     """
     from .render import Renderer, colour_limits, hinge_values
 
-    positions = [np.asarray(p, dtype=float) for p in positions]
-    if not positions:
-        raise RenderError("no frames to render")
+    positions, titles = checked_frames(positions, titles)
     options = {}
     if scalars is not None:
         scalars = [hinge_values(pattern, mesh, s) for s in scalars]
@@ -182,17 +180,34 @@ def render_frames(pattern, mesh, positions, *, size=(640, 480), view="iso", scal
             raise RenderError(f"{len(scalars)} scalar arrays for {len(positions)} frames")
         options.update(scalars=scalars[0], scalar_name=scalar_name,
                        clim=colour_limits(np.concatenate(scalars)) if clim is None else clim)
-    title = None if titles is None else list(titles)
-    if title is not None and len(title) != len(positions):
-        raise RenderError(f"{len(title)} titles for {len(positions)} frames")
+    renderer = Renderer(pattern, mesh, size, view, title=titles[0] if titles else None,
+                        **options)
+    return take_frames(renderer, positions, titles, scalars, progress)
+
+
+def checked_frames(positions, titles=None) -> tuple[list, list | None]:
+    """``positions`` as a list of float arrays and ``titles`` as a list (or None);
+    RenderError when there is no frame or not one title per frame."""
+    positions = [np.asarray(p, dtype=float) for p in positions]
+    if not positions:
+        raise RenderError("no frames to render")
+    titles = None if titles is None else list(titles)
+    if titles is not None and len(titles) != len(positions):
+        raise RenderError(f"{len(titles)} titles for {len(positions)} frames")
+    return positions, titles
+
+
+def take_frames(renderer, positions: list, titles=None, scalars=None, progress=None) -> list:
+    """The pictures of ``renderer`` (a :class:`foldcore.render.Renderer`, closed after)
+    moved to each of ``positions`` (:func:`checked_frames`) in turn, with the camera
+    fitted to all of them at once; each frame's title and scalars when given."""
     frames = []
-    with Renderer(pattern, mesh, size, view, title=title[0] if title else None,
-                  **options) as r:
+    with renderer as r:
         r.update(positions[0])
         r.fit(np.vstack(positions))
         for i, x in enumerate(_progress(positions, progress, "render")):
             r.update(x, None if scalars is None else scalars[i],
-                     None if title is None else title[i])
+                     None if titles is None else titles[i])
             frames.append(r.image())
     return frames
 

@@ -12,8 +12,8 @@ from __future__ import annotations
 import numpy as np
 
 from .errors import PatternError
-from .render import (EDGE_COLOUR, HINGE_COLOURS, PANEL_COLOUR, Renderer, RenderError,
-                     behind_lines, colour_limits, require_pyvista)
+from .render import (EDGE_COLOUR, HINGE_COLOURS, PANEL_COLOUR, Renderer, behind_lines,
+                     colour_limits, require_pyvista)
 
 
 class SheetRenderer(Renderer):
@@ -64,21 +64,22 @@ class SheetRenderer(Renderer):
         ``creases`` (the boundary black); the PolyData added."""
         kinds = np.asarray(self.pattern.assignments)
         edges = np.asarray(self.pattern.edges)
-        groups = {"B": EDGE_COLOUR, **HINGE_COLOURS} if creases is None else {"B": EDGE_COLOUR,
-                                                                            "creases": None}
+        groups = [(kinds == "B", EDGE_COLOUR, 1)]  # (which edges, colour or None: by value, width)
+        if creases is None:
+            groups += [(kinds == kind, colour, 2) for kind, colour in HINGE_COLOURS.items()]
+        else:
+            groups.append((kinds != "B", None, 3))
         added = []
-        for kind, colour in groups.items():
-            chosen = kinds == "B" if kind == "B" else (kinds != "B" if creases is not None
-                                                       else kinds == kind)
+        for chosen, colour, width in groups:
             if not chosen.any():
                 continue
             lines = pv.PolyData(x.copy(), lines=np.hstack(
                 [np.full((int(chosen.sum()), 1), 2), edges[chosen]]).ravel())
             if colour is None:
                 lines.cell_data["value"] = np.asarray(creases, dtype=float)[chosen]
-                self.add_scalars(lines, name, cmap, line_width=3)
+                self.add_scalars(lines, name, cmap, line_width=width)
             else:
-                self.plotter.add_mesh(lines, color=colour, line_width=2 if kind != "B" else 1)
+                self.plotter.add_mesh(lines, color=colour, line_width=width)
             added.append(lines)
         return added
 
@@ -111,21 +112,12 @@ def render_sheet_frames(pattern, triangles, positions, *, size=(640, 480), view=
     camera fitted to all of them (as :func:`foldcore.animate.render_frames`);
     ``titles``: text in the upper-left corner of each. A list of (height, width, 3)
     uint8."""
-    positions = [np.asarray(p, dtype=float) for p in positions]
-    if not positions:
-        raise RenderError("no frames to render")
-    titles = None if titles is None else list(titles)
-    if titles is not None and len(titles) != len(positions):
-        raise RenderError(f"{len(titles)} titles for {len(positions)} frames")
-    frames = []
-    with SheetRenderer(pattern, triangles, size, view,
-                       title=titles[0] if titles else None) as r:
-        r.update(positions[0])
-        r.fit(np.vstack(positions))
-        for i, x in enumerate(positions):
-            r.update(x, title=None if titles is None else titles[i])
-            frames.append(r.image())
-    return frames
+    from .animate import checked_frames, take_frames
+
+    positions, titles = checked_frames(positions, titles)
+    renderer = SheetRenderer(pattern, triangles, size, view,
+                             title=titles[0] if titles else None)
+    return take_frames(renderer, positions, titles, progress=False)
 
 
 def render_sheet_result(result, path, size=(1024, 768), view="iso",
