@@ -51,9 +51,9 @@ def run_thin(job, loaded, on_start=None, callback=None):
     """(sheet, solver, result, interrupted, sweep): ``job``'s pattern (``loaded``, the
     file read) folded as a thin sheet. Ctrl-C ends a single run with its last
     iterate (``interrupted`` True, ``result.reason == "interrupted"``). With a
-    series or an animation asked for, ``sweep`` is :func:`sweep_thin`'s and the
-    result its last frame (an interrupted sweep writes nothing, as a thick one);
-    else None."""
+    series or an animation asked for, ``sweep`` is :func:`sweep_thin`'s, the
+    result its last frame and the solver that frame's (an interrupted sweep writes
+    nothing, as a thick one); else None."""
     from .sheet import SheetSolver, build_sheet
 
     warnings.warn(f"{job.source}: {THIN_NOTE}", RunWarning, stacklevel=3)
@@ -67,13 +67,15 @@ def run_thin(job, loaded, on_start=None, callback=None):
         warnings.warn(f"{job.source}: {which} of degree 2 on straight lines left out of "
                       f"the thin sheet, their edges merged, as Origami Simulator reads a "
                       f"drawing (each follows its merged edge)", RunWarning, stacklevel=3)
-    solver = SheetSolver(sheet, s.fold_percent, pattern_edges=pattern.n_edges)
+    sweeping = bool(job.outputs.series or job.outputs.animate)
+    solver = None if sweeping else SheetSolver(sheet, s.fold_percent,
+                                               pattern_edges=pattern.n_edges)
     setup = time.perf_counter() - t0
     if on_start is not None:
         on_start()
     sweep, interrupted = None, False
-    if job.outputs.series or job.outputs.animate:
-        sweep = sweep_thin(job, sheet, pattern)
+    if sweeping:
+        sweep, solver = sweep_thin(job, sheet, pattern)
         result = sweep[-1][1]
         result.timings_s["solve"] = sum(r.timings_s["solve"] for _, r in sweep)
     else:
@@ -85,20 +87,21 @@ def run_thin(job, loaded, on_start=None, callback=None):
     return sheet, solver, result, interrupted, sweep
 
 
-def sweep_thin(job, sheet, pattern) -> list:
-    """[(fold percent, SheetFold)]: the sheet folded from flat to ``job``'s fold percent
-    in ``outputs.frames`` even steps, each from the last frame's positions (each
-    frame's ``iterations`` counted from the sweep's start, as a thick sweep's); with
-    ``outputs.animate`` the frames rendered (:func:`foldcore.sheet_render.
-    render_sheet_frames`, one camera for all) and written as the animation."""
+def sweep_thin(job, sheet, pattern) -> tuple[list, object]:
+    """([(fold percent, SheetFold)], the last frame's SheetSolver): the sheet folded
+    from flat to ``job``'s fold percent in ``outputs.frames`` even steps, each from
+    the last frame's positions (each frame's ``iterations`` counted from the sweep's
+    start, as a thick sweep's); with ``outputs.animate`` the frames rendered
+    (:func:`foldcore.sheet_render.render_sheet_frames`, one camera for all) and
+    written as the animation."""
     from .animate import percent_schedule, write_animation
     from .sheet import SheetSolver
 
     s, out = job.solving, job.outputs
     sweep, start, steps = [], None, 0
     for percent in percent_schedule(out.frames, s.fold_percent):
-        fold = SheetSolver(sheet, float(percent), start=start,
-                           pattern_edges=pattern.n_edges).run(s.tolerance, newton_budget(s))
+        solver = SheetSolver(sheet, float(percent), start=start, pattern_edges=pattern.n_edges)
+        fold = solver.run(s.tolerance, newton_budget(s))
         steps = fold.iterations = steps + fold.iterations  # from the sweep's start, as thick
         sweep.append((float(percent), fold))
         start = fold.positions
@@ -109,7 +112,7 @@ def sweep_thin(job, sheet, pattern) -> list:
                                      [f.positions for _, f in sweep],
                                      titles=[f"fold {p:.4g} %" for p, _ in sweep])
         write_animation(out.animate, frames, out.fps)
-    return sweep
+    return sweep, solver
 
 
 def newton_budget(solving) -> int:
