@@ -29,8 +29,8 @@ A thin sheet's result (:class:`foldcore.result_file.SheetResultFile`) has no
 strips or panels: its flat sheet is its lines (:func:`crease_lines`), each
 edge one open segment — ``CUT`` the boundary edges (both sides of a cut
 drawn once), ``HINGE_M`` / ``HINGE_V`` / ``HINGE_F`` / ``HINGE`` the creases
-— and its STL the folded triangles, a surface without thickness. Result files (``foldcore simulate -o``)
-are read back by :func:`foldcore.result_file.read_result`. Every file is
+— and its STL the folded triangles, a surface without thickness. Result files
+(``foldcore simulate -o``) are read back by :func:`foldcore.result_file.read_result`. Every file is
 written atomically (:mod:`foldcore.files`): it appears complete or not at all.
 Design notes:
 ``docs/architecture.md#fabrication-files``.

@@ -87,7 +87,8 @@ def fit_widths(pattern, widths, automatic) -> np.ndarray:
     every crease keeps a strip (:func:`.strips.short_creases`). In the way: the sides
     of a face too small, the creases at either end of a crease too short. A crease
     is narrowed with the creases collinear with it through a vertex
-    (:func:`collinear_groups`: a panel's straight side keeps one inset). Widths the
+    (:func:`collinear_groups`), so a panel's straight side keeps one inset instead
+    of stepping across the vertex (:mod:`.panels`). Widths the
     user gave are kept; a face or crease still too small is refused when the mesh
     is built."""
     from .panels import inset_faces
