@@ -287,14 +287,15 @@ def test_angle_actuation_stiffens_the_actuated_strips_only():
 
 
 def test_k_is_factorised_at_its_first_use_and_then_matches_the_current_weights():
-    """A rigid-body fold never solves with K: it is not factorised (and the run reports
-    no bare-solve time). Weights and pins changed before the first use are in the
-    factor that use builds, as in one built from them at once."""
+    """The rigid-body model asked for by name never solves with K: it is not
+    factorised (and the run reports no bare-solve time). Weights and pins changed
+    before the first use are in the factor that use builds, as in one built from
+    them at once."""
     from foldcore.linsolve import Factor
 
     pattern = patterns.degree4_vertex(radius=10.0, widths=[0.03] * 4, rho1=40.0)
     mesh = thicken(pattern, 0.01)
-    sim = Simulation(mesh, pattern)
+    sim = Simulation(mesh, pattern, solver="rigid")
     result = sim.run(tolerance=1e-8)
     assert result.converged and not sim.system.factored
     assert "bare_solve" not in result.timings_s

@@ -15,8 +15,9 @@ converges and the other does not.
 
 Run: ``python tools/verdict_check.py [--units] [COUNT] [SEED] [BUDGET]``
 (defaults 300, 7, 2000; about 5 min on 2 cores, twice that with ``--units``);
-writes tools/results/verdict_check.json (one record per run and the counts per
-strategy) and prints the counts.
+writes tools/results/verdict_check.json (one record per run, with the
+certificate's checks and time, and the counts per strategy with the
+certificate's median cost) and prints them.
 """
 from __future__ import annotations
 
@@ -53,8 +54,12 @@ def check(problem, mesh, solver: str, budget: int, units: bool = False) -> dict:
     sim = Simulation(mesh, problem.pattern, solver=solver)
     start = time.perf_counter()
     result = sim.run(tolerance=TOLERANCE, max_iterations=budget)
+    certificate = sim.convergence.certificate
     record = {"problem": problem.name, "solver": solver, "reason": result.reason,
-              "iterations": result.iterations, "seconds": time.perf_counter() - start}
+              "iterations": result.iterations, "seconds": time.perf_counter() - start,
+              "certificate_checks": certificate.checks,
+              "certificate_seconds": certificate.seconds,
+              "map_step_seconds": certificate.map_seconds}
     if units:
         scaled = problem.scaled(1e3)
         um = Simulation(thicken(scaled.pattern, scaled.thickness), scaled.pattern,
@@ -71,6 +76,19 @@ def check(problem, mesh, solver: str, budget: int, units: bool = False) -> dict:
         record.update(moved_limits=moved, turned_deg=turned, bound_deg=bound,
                       false=bool(moved > 2.0 and turned > bound))
     return record
+
+
+def certificate_cost(records: list[dict]) -> dict:
+    """Over the runs the certificate judged: its median time per run, s, and its
+    share of the run's time, and the median time of its map-step test (step 4), s."""
+    checked = [r for r in records if r["certificate_checks"]]
+    if not checked:
+        return {"certified_runs": 0}
+    return {"certified_runs": len(checked),
+            "certificate_s_median": float(np.median([r["certificate_seconds"] for r in checked])),
+            "certificate_share_median": float(np.median(
+                [r["certificate_seconds"] / r["seconds"] for r in checked])),
+            "map_step_s_median": float(np.median([r["map_step_seconds"] for r in checked]))}
 
 
 def main() -> None:
@@ -91,14 +109,21 @@ def main() -> None:
     differ = Counter(r["solver"] for r in records
                      if units and (r["reason"] == "converged") != (r["um_reason"] == "converged"))
     summary = {s: {"runs": count, "converged": converged[s], "false": false[s],
-                   **({"unit_disagreements": differ[s]} if units else {})} for s in SOLVERS}
+                   **({"unit_disagreements": differ[s]} if units else {}),
+                   **certificate_cost([r for r in records if r["solver"] == s])}
+               for s in SOLVERS}
     out = ROOT / "tools" / "results" / "verdict_check.json"
     out.write_text(json.dumps({"count": count, "seed": seed, "budget": budget,
                                "tolerance": TOLERANCE, "units": units, "summary": summary,
                                "runs": records}, indent=1))
     for s in SOLVERS:
+        cost = summary[s]
         print(f"{s:9s} converged {converged[s]:4d}  false {false[s]:3d}"
-              + (f"  unit disagreements {differ[s]:3d}" if units else ""))
+              + (f"  unit disagreements {differ[s]:3d}" if units else "")
+              + (f"  certificate median {1e3 * cost['certificate_s_median']:.1f} ms"
+                 f" ({100 * cost['certificate_share_median']:.0f} % of the run),"
+                 f" map step {1e3 * cost['map_step_s_median']:.1f} ms"
+                 if cost["certified_runs"] else ""))
 
 
 if __name__ == "__main__":

@@ -21,6 +21,15 @@ model's own Gauss–Newton linearisation (:mod:`foldcore.model.linearisation`)
    lands on a state E cannot tell from this one (the tolerance is below what
    the state resolves: refused); a damped one after an overshoot is no
    evidence of a lower state (damped further).
+4. A step within the limit must still find E rising beyond the limit: H
+   holds a passive strip's bend as stiff as an actuated one, so where the
+   strips give, its step is far too short (a thin vertex's ``newton`` crawls
+   toward an equilibrium 10³ limits away while H predicts 0.3 limit). Along
+   the paper's map step −K⁻¹ ½∇E, which lets the strips follow, and along
+   the run's last step, E at 1 and 2 limits decides: falling from 1 to 2 by
+   more than its rounding, the equilibrium on that line is farther than the
+   limit — refused, the residual the vertex of the parabola through the
+   three energies (at least 2 limits).
 
 Scale-free: the move is compared with tolerance × size, energy changes with
 E's rounding at the state, λ is relative to K's diagonal; the same state in mm
@@ -28,8 +37,9 @@ and in µm gets the same answer. Its resolution is the rounding of ½∇E throug
 H (about 1e-11 × the size on a thick waterbomb, 3e-10 on a thick Miura driven
 flat): a tolerance below it cannot be certified. Cost: one assembly of H, one
 factorisation and one energy per trial (one trial at most states, a few where
-H is soft in directions E is not), at the end of a run only; K's factor is not
-needed and H's is freed after.
+H is soft in directions E is not), plus one K solve and two to four energies
+for step 4, at the end of a run only; H's factor is freed after, K's (built at
+the first check where no strategy has built it) is kept.
 """
 from __future__ import annotations
 
@@ -59,25 +69,31 @@ class Certificate:
     trials : list of (float, float, float)
         The last check's trials: λ, predicted move / limit, energy change / the
         rounding noise (NaN where the move was within the limit).
+    probe : (float, float) or None
+        The last check's E at 1 and 2 limits along the last direction step 4
+        probed, minus E, / the rounding noise (None where none was probed).
     checks, seconds : int, float
         Checks so far and their time, s.
+    map_seconds : float
+        The share of :attr:`seconds` spent on step 4, s.
     """
 
     def __init__(self, model):
         self.model = model
-        self.residual, self.trials = np.nan, []
-        self.checks, self.seconds = 0, 0.0
+        self.residual, self.trials, self.probe = np.nan, [], None
+        self.checks, self.seconds, self.map_seconds = 0, 0.0, 0.0
 
-    def check(self, limit: float) -> bool:
+    def check(self, limit: float, last_step=None) -> bool:
         """Whether the model's state is its equilibrium within ``limit`` mm (tolerance ×
-        size). Sets :attr:`residual`."""
+        size); ``last_step`` ((N, 3) mm or None) is the run's last step, a direction
+        step 4 probes. Sets :attr:`residual`."""
         model = self.model
         start = time.perf_counter()
         targets = model.slot_targets.copy()
         linear = Linearisation(model)
         try:
             with model.scratch_projections():
-                move, passed = self._trials(linear, limit)
+                move, passed = self._trials(linear, limit, last_step)
         finally:
             model.slot_targets[:] = targets
             linear.release()
@@ -86,15 +102,15 @@ class Certificate:
         self.residual = move / model.length_scale
         return passed
 
-    def _trials(self, linear, limit: float) -> tuple[float, bool]:
-        """(predicted move mm of the deciding trial, certified) — steps 1–3."""
+    def _trials(self, linear, limit: float, last_step) -> tuple[float, bool]:
+        """(predicted move mm of the deciding trial, certified) — steps 1–4."""
         model, x = self.model, self.model.x
         energy, rhs = model.local_step(x)
         gradient = linear.gradient(x, rhs)
         values = linear.hessian(model.slot_targets)
         floor = self.energy_floor()  # E's rounding at this state: residuals rounded
         noise = ROUNDING * energy + 2.0 * np.sqrt(energy * floor) + floor  # by ROUNDING × size
-        damping, move, self.trials = DAMPING[0], np.inf, []
+        damping, move, self.trials, self.probe = DAMPING[0], np.inf, [], None
         while damping <= DAMPING[1]:
             try:
                 delta = linear.solve(values, -gradient, damping).reshape(-1, 3)
@@ -107,13 +123,53 @@ class Certificate:
             share = move / limit if limit > 0 else np.inf
             if move <= limit:
                 self.trials.append((damping, share, np.nan))
-                return move, True
+                farther = self.falls_beyond(x, gradient, energy, noise, limit, last_step)
+                return (move, True) if farther is None else (farther, False)
             change = (model.local_step(x + delta)[0] - energy) / noise
             self.trials.append((damping, share, change))
             if change < -1.0 or (abs(change) <= 1.0 and len(self.trials) == 1):
                 return move, False  # a lower state, or the Newton step E cannot judge
             damping *= DAMPING_UP  # the linear model overshot: a shorter step
         return move, False
+
+    def falls_beyond(self, x: np.ndarray, gradient: np.ndarray, energy: float,
+                     noise: float, limit: float, last_step=None) -> float | None:
+        """Step 4: where E still falls beyond ``limit`` mm along the paper's map step
+        −K⁻¹ ½∇E (``gradient``: ½∇E = K x − b(x), (3N,) mm⁴) or along ``last_step``
+        ((N, 3) mm, the run's last step, if given), the distance (mm) to the lowest E
+        on that line; else None."""
+        start = time.perf_counter()
+        try:
+            directions = [lambda: -self.model.global_step(gradient.reshape(-1, 3))]
+            if last_step is not None:
+                directions.append(lambda: last_step)
+            for direction in directions:
+                farther = self._falls_along(x, direction(), energy, noise, limit)
+                if farther is not None:
+                    return farther
+            return None
+        finally:
+            self.map_seconds += time.perf_counter() - start
+
+    def _falls_along(self, x: np.ndarray, step: np.ndarray, energy: float, noise: float,
+                     limit: float) -> float | None:
+        """E at 1 and 2 limits along ``step`` (N, 3) mm: falling from 1 to 2 by more
+        than ``noise``, the vertex of the parabola through E at 0, 1 and 2 limits (at
+        least 2 limits; 2 where its curvature is within rounding), mm; else None."""
+        model = self.model
+        if not model.position_targets:
+            step = without_rigid_motion(step, x)
+        reach = float(np.abs(step).max())
+        if not reach > ROUNDING * model.length_scale:  # a fixed point of the map
+            return None
+        near, far = (model.local_step(x + share * limit / reach * step)[0] for share in (1.0, 2.0))
+        self.probe = ((near - energy) / noise, (far - energy) / noise)
+        if not (near < energy and far < near - noise):
+            return None
+        curvature = far - 2.0 * near + energy  # E'' × limit²
+        slope = (4.0 * near - 3.0 * energy - far) / 2.0  # E'(0) × limit
+        lowest = -slope / curvature if curvature > noise else 2.0
+        return limit * max(2.0, lowest)
 
     def energy_floor(self) -> float:
         """mm⁵: the energy of residuals at rounding level (every vertex off by

@@ -96,6 +96,9 @@ class ConvergenceTest:
     certificate : foldcore.certificate.Certificate
     strategy : foldcore.strategies.Strategy or None
         The strategy whose settled states the test certifies (:meth:`attach`).
+    last_step : (N, 3) float or None
+        The last reported step, mm (None before the run's first): a direction along
+        which the certificate checks that E does not fall beyond the limit.
     """
 
     def __init__(self, model, progress: Progress):
@@ -106,6 +109,8 @@ class ConvergenceTest:
         self.certificate = Certificate(model)
         self.strategy = None
         self.moved = 0.0  # the last reported step's largest move, mm
+        self._last = None  # the state after the last reported step (copied)
+        self.last_step = None
         self._model, self._progress = model, progress
 
     def attach(self, strategy) -> None:
@@ -122,6 +127,8 @@ class ConvergenceTest:
     def check(self, report: Report, limit: float, steps_left: int) -> str | None:
         """``"converged"``, ``"stalled"`` or None (go on) after a step of a run whose
         limit is ``limit`` mm (tolerance × size) with ``steps_left`` in its budget."""
+        previous, self._last = self._last, self._model.x.copy()
+        self.last_step = None if previous is None else self._last - previous
         if report.residual is not None:
             self.probe.residual = report.residual
         self.moved = report.moved
@@ -157,7 +164,7 @@ class ConvergenceTest:
     def certified(self, limit: float) -> bool:
         """Whether the model's state passes the equilibrium certificate at ``limit`` mm;
         its residual becomes the test's."""
-        passed = self.certificate.check(limit)
+        passed = self.certificate.check(limit, self.last_step)
         self.probe.residual = self.certificate.residual
         return passed
 
@@ -183,6 +190,7 @@ class ConvergenceTest:
     def begin_run(self) -> None:
         """A run starts (its stages each call :meth:`new_stage`)."""
         self.moved = 0.0
+        self._last = self._model.x.copy()
         self.probe.begin_run()
 
     def new_stage(self) -> None:
