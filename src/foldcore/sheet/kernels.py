@@ -8,7 +8,7 @@ that are easy to get wrong). Not the bars': their axial stiffness dwarfs the
 bending springs (a bar by a facet 1e-3 high has k ≈ 1e4), so a difference's
 1e-8 relative error in their blocks is larger than the soft directions'
 entries, and Newton's steps along those stall (Origami Simulator's shell14
-at 60 %: 500 steps, 25 s, unsettled; with analytic bars 115 steps):
+at 60 %: 500 steps, 25 s, unsettled; with analytic bars 58 steps):
 
 * **bar** ``(a, b)``: ``½ k (L − L₀)²``;
 * **hinge** ``(a, b, c, d)``: ``½ k (φ − φ̄)²``, the hinge on ``a → b``, ``c``
