@@ -304,7 +304,7 @@ class Simulation:
             finally:  # an interrupted run's time counts too
                 self.progress.stage = None
                 self.timings["total"] += time.perf_counter() - start
-        if self.model.system.factored:  # a rigid-body run never needs K
+        if self.model.system.factored:  # `rigid` never needs K
             self.timings["bare_solve"] = self._bare_solve_floor()
         result = self.result(reason == "converged", reason)
         log.info("run %d ended %s after %d iterations (residual %.2g, %.3g s)",
