@@ -96,9 +96,6 @@ class ConvergenceTest:
     certificate : foldcore.certificate.Certificate
     strategy : foldcore.strategies.Strategy or None
         The strategy whose settled states the test certifies (:meth:`attach`).
-    last_step : (N, 3) float or None
-        The last reported step, mm (None before the run's first): a direction along
-        which the certificate checks that E does not fall beyond the limit.
     """
 
     def __init__(self, model, progress: Progress):
@@ -109,14 +106,19 @@ class ConvergenceTest:
         self.certificate = Certificate(model)
         self.strategy = None
         self.moved = 0.0  # the last reported step's largest move, mm
-        self._last = None  # the state after the last reported step (copied)
-        self.last_step = None
+        self._before = self._last = None  # the states before and after the last step
         self._model, self._progress = model, progress
 
     def attach(self, strategy) -> None:
         """The strategy the run's reports come from: asked whether it goes on where
         the certificate refuses a state it called settled."""
         self.strategy = strategy
+
+    @property
+    def last_step(self):
+        """The last reported step, (N, 3) mm (None before the run's first): a direction
+        along which the certificate checks that E does not fall beyond the limit."""
+        return None if self._before is None else self._last - self._before
 
     @property
     def residual(self) -> float:
@@ -127,8 +129,7 @@ class ConvergenceTest:
     def check(self, report: Report, limit: float, steps_left: int) -> str | None:
         """``"converged"``, ``"stalled"`` or None (go on) after a step of a run whose
         limit is ``limit`` mm (tolerance × size) with ``steps_left`` in its budget."""
-        previous, self._last = self._last, self._model.x.copy()
-        self.last_step = None if previous is None else self._last - previous
+        self._before, self._last = self._last, self._model.x.copy()
         if report.residual is not None:
             self.probe.residual = report.residual
         self.moved = report.moved
@@ -190,7 +191,7 @@ class ConvergenceTest:
     def begin_run(self) -> None:
         """A run starts (its stages each call :meth:`new_stage`)."""
         self.moved = 0.0
-        self._last = self._model.x.copy()
+        self._before, self._last = None, self._model.x.copy()
         self.probe.begin_run()
 
     def new_stage(self) -> None:
