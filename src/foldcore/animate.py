@@ -57,6 +57,11 @@ def percent_schedule(frames: int, stop: float = 100.0, start: float = 0.0) -> np
     return np.linspace(float(start), float(stop), int(frames))
 
 
+def frame_titles(percents) -> list[str]:
+    """The title of each frame of a sweep through ``percents`` (fold percent)."""
+    return [f"fold {p:.4g} %" for p in percents]
+
+
 def check_output(path) -> str:
     """The animation format of ``path`` (``".gif"`` or ``".mp4"``); checks its encoder.
 
@@ -289,7 +294,7 @@ def animate(sim, percents, path=None, *, fps: float = 10.0, size=(640, 480), vie
         clim = colour_limits(every, signed=True)
     frames = render_frames(sim.pattern, sim.mesh, [r.positions for r in results], size=size,
                            view=view, scalars=scalars, scalar_name=name, clim=clim,
-                           titles=[f"fold {p:.4g} %" for p in percents], progress=progress)
+                           titles=frame_titles(percents), progress=progress)
     if path is not None:
         write_animation(path, frames, fps)
     return Animation(percents, results, frames)

@@ -94,7 +94,7 @@ def sweep_thin(job, sheet, pattern) -> tuple[list, object]:
     start, as a thick sweep's); with ``outputs.animate`` the frames rendered
     (:func:`foldcore.sheet_render.render_sheet_frames`, one camera for all) and
     written as the animation."""
-    from .animate import percent_schedule, write_animation
+    from .animate import frame_titles, percent_schedule, write_animation
     from .sheet import SheetSolver
 
     s, out = job.solving, job.outputs
@@ -110,7 +110,7 @@ def sweep_thin(job, sheet, pattern) -> tuple[list, object]:
 
         frames = render_sheet_frames(pattern, sheet.pattern_triangles,
                                      [f.positions for _, f in sweep],
-                                     titles=[f"fold {p:.4g} %" for p, _ in sweep])
+                                     titles=frame_titles(p for p, _ in sweep))
         write_animation(out.animate, frames, out.fps)
     return sweep, solver
 
