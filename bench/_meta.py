@@ -22,6 +22,7 @@ import json
 import os
 import platform
 import statistics
+import subprocess
 import sys
 import tempfile
 import time
@@ -221,6 +222,25 @@ def timed(run):
     start = time.perf_counter()
     value = run()
     return time.perf_counter() - start, value
+
+
+def cli_seconds(args: list, limit_s: float | None = None, check: bool = False) -> float | None:
+    """Wall seconds of the whole ``python -m foldcore *args`` process (start-up, reading
+    and writing included), run in a temporary folder; None past ``limit_s``. With
+    ``check`` a failed run raises SystemExit with its last line of stderr."""
+    with tempfile.TemporaryDirectory() as tmp:
+        start = time.perf_counter()
+        try:
+            proc = subprocess.run([sys.executable, "-m", "foldcore", *map(str, args)],
+                                  cwd=tmp, capture_output=True, text=True, check=False,
+                                  timeout=limit_s)
+        except subprocess.TimeoutExpired:
+            return None
+        seconds = time.perf_counter() - start
+    if check and proc.returncode != 0:
+        last = (proc.stderr.strip().splitlines() or ["(no message)"])[-1]
+        raise SystemExit(f"foldcore {' '.join(map(str, args))}: exit {proc.returncode}: {last}")
+    return seconds
 
 
 def median(values) -> float:

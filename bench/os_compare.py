@@ -34,8 +34,6 @@ Simulator's, and the shape differences). Run: ``python bench/os_compare.py``
 """
 from __future__ import annotations
 
-import subprocess
-import sys
 import tempfile
 import time
 import warnings
@@ -188,22 +186,10 @@ def one_file(path: Path, svgs: Path, runs: int) -> dict:
                                  "seconds": seconds}
         row["folds"].append(out)
     if user_pattern is not None:
-        row["cli_s"], row["os_load_s"] = cli_seconds(svg), state.get("load_seconds")
+        row["cli_s"] = _meta.cli_seconds(["simulate", svg, "--fold-percent", CLI_PERCENT, "-q"],
+                                         CLI_LIMIT_S, check=True)
+        row["os_load_s"] = state.get("load_seconds")
     return row
-
-
-def cli_seconds(svg: Path) -> float | None:
-    """Wall seconds of the whole ``foldcore simulate SVG --fold-percent 90 -q`` process;
-    None past :data:`CLI_LIMIT_S`."""
-    with tempfile.TemporaryDirectory() as tmp:
-        t0 = time.perf_counter()
-        try:
-            subprocess.run([sys.executable, "-m", "foldcore", "simulate", str(svg),
-                            "--fold-percent", str(CLI_PERCENT), "-q"], cwd=tmp,
-                           capture_output=True, check=False, timeout=CLI_LIMIT_S)
-        except subprocess.TimeoutExpired:
-            return None
-        return time.perf_counter() - t0
 
 
 def tied_quadrilaterals(state: dict) -> tuple[int, int]:
