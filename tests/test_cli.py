@@ -67,7 +67,7 @@ def test_not_converging_is_a_result_with_a_warning(fold_file, tmp_path, capsys):
     assert code == 0
     rep = json.loads(report.read_text())
     assert rep["converged"] is False and rep["reason"] == "budget"
-    assert "not converged" in capsys.readouterr().err
+    assert "its budget of 5 iterations ran out" in capsys.readouterr().err
     assert out.exists()
 
 

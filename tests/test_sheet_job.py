@@ -127,7 +127,11 @@ def test_the_newton_budget_is_the_sheets_own_unless_given(miura_file, tmp_path):
         foldcore.simulate(miura_file, outputs={"report": report})
         assert json.loads(report.read_text())["settings"]["max_iterations"] == 500
         short = foldcore.simulate(miura_file, solving={"max_iterations": 2})
+        foldcore.simulate(miura_file, solving={"max_iterations": 10_000},
+                          outputs={"report": report})
     assert short.iterations == 2 and short.reason == "budget" and not short.converged
+    # a budget given is kept, even one equal to a thick sheet's default
+    assert json.loads(report.read_text())["settings"]["max_iterations"] == 10_000
 
 
 def test_a_drawings_straight_degree2_vertices_are_left_out_and_said(tmp_path, capsys):

@@ -31,8 +31,8 @@ from .destinations import check_destinations
 from .errors import FoldcoreError
 from . import interrupts, result_commands
 from .limits import (CELL_RATIO, GROUND_RATIO, LENGTH_MM, MARGIN_RATIO, MAX_ELASTIC_VERTICES,
-                     MAX_DRIVEN, MAX_ITERATIONS, MAX_MESH_VERTICES, STROKE_RATIO, SUBDIVISIONS,
-                     THICKNESS_RATIO, TOLERANCE, UNITLESS_SHEET_MM, WIDTH_RATIO)
+                     MAX_DRIVEN, MAX_ITERATIONS, MAX_MESH_VERTICES, SHEET_BUDGET, STROKE_RATIO,
+                     SUBDIVISIONS, THICK_BUDGET, THICKNESS_RATIO, TOLERANCE, UNITLESS_SHEET_MM, WIDTH_RATIO)
 from .options import CONTACT_CHOICES, MAX_FPS, MAX_FRAMES
 from .study import commands as study_commands
 from .strategies import DEFAULT_SOLVER, SOLVERS
@@ -248,8 +248,9 @@ def _add_solving(sim) -> None:
                           f"equilibrium, {TOLERANCE[0]:g} … {TOLERANCE[1]:g} (default 1e-8): "
                           "looser, a run reads converged degrees short of it; tighter, float64 "
                           "cannot resolve it")
-    sim.add_argument("--max-iterations", type=int, default=10_000,
-                     help=f"iteration budget, 1 … {MAX_ITERATIONS:,} (default 10,000)")
+    sim.add_argument("--max-iterations", type=int, default=None,
+                     help=f"iteration budget, 1 … {MAX_ITERATIONS:,} (default {THICK_BUDGET:,} "
+                          f"for a thick sheet, {SHEET_BUDGET:,} Newton steps for a thin one)")
     sim.add_argument("--actuation", choices=ACTUATIONS, default=DEFAULT_ACTUATION,
                      help="equal (an actuated hinge weighs what a passive one does, the "
                           "paper's) or angle (actuated hinges 1000x stiffer: their angles are "
@@ -470,7 +471,8 @@ def _why(result) -> str:
     far = ("" if math.isnan(result.residual) else  # NaN: never estimated
            f", the equilibrium estimated {result.residual:.1e} × the pattern size away")
     return {"stalled": "stalled: no step of the strategy reaches the equilibrium" + far,
-            "budget": "--max-iterations reached" + far,
+            "budget": f"its budget of {result.iterations:,} iterations ran out "
+                      "(--max-iterations sets it)" + far,
             "callback": "stopped"}.get(result.reason, result.reason)
 
 

@@ -48,6 +48,10 @@ TOLERANCE = (1e-15, 1e-2)
 #: Iteration budget accepted per run: the report lists every iteration's energy
 #: (10⁶ of them are about 20 MB of JSON).
 MAX_ITERATIONS = 1_000_000
+#: Default iteration budgets: a thick sheet's strategies take many cheap steps,
+#: a thin sheet's Newton method tens (``solving.max_iterations`` = None).
+THICK_BUDGET = 10_000
+SHEET_BUDGET = 500
 #: Larger extent, mm, of a FOLD sheet whose file declares no unit of length
 #: (``frame_unit`` absent or ``"unit"``: most files are unit squares), unless a
 #: size or a scale is given: a sheet of paper's order, on which millimetre

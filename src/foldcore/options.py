@@ -16,7 +16,7 @@ from dataclasses import dataclass, fields
 from .actuation import ACTUATIONS, BRANCH_FLOOR_DEG, DEFAULT_ACTUATION
 from .errors import FoldcoreError
 from .hinges import HINGE_MODELS
-from .limits import MAX_ITERATIONS, SUBDIVISIONS, TOLERANCE
+from .limits import MAX_ITERATIONS, SUBDIVISIONS, THICK_BUDGET, TOLERANCE
 from .strategies import DEFAULT_SOLVER
 
 MAX_FRAMES = 10_000
@@ -109,9 +109,12 @@ class Solving:
         within tolerance × size of the equilibrium, so a looser one reads
         "converged" degrees short of it, and a tighter one cannot be resolved in
         float64.
-    max_iterations : int
+    max_iterations : int, optional
         Iteration budget of the run (of each frame of a sweep), in 1..1 000 000
-        (:data:`foldcore.limits.MAX_ITERATIONS`).
+        (:data:`foldcore.limits.MAX_ITERATIONS`); None (default): the model's own,
+        :data:`foldcore.limits.THICK_BUDGET` iterations of a thick sheet's strategy or
+        :data:`foldcore.limits.SHEET_BUDGET` Newton steps of a thin sheet
+        (:attr:`budget`).
     actuation : {"equal", "angle"}
     branch_floor : float
         Degrees ≥ 0 passive M/V creases are held on their assigned side while a
@@ -136,13 +139,19 @@ class Solving:
     fold_percent: float = 100.0
     solver: str = DEFAULT_SOLVER
     tolerance: float = 1e-8
-    max_iterations: int = 10_000
+    max_iterations: int | None = None
     actuation: str = DEFAULT_ACTUATION
     branch_floor: float = BRANCH_FLOOR_DEG
     strategy_options: object = None
     contact: str = "off"
     obstacles: tuple = ()
     ground: float | None = None
+
+    @property
+    def budget(self) -> int:
+        """A thick sheet's iteration budget: ``max_iterations``, or
+        :data:`foldcore.limits.THICK_BUDGET`."""
+        return THICK_BUDGET if self.max_iterations is None else self.max_iterations
 
     @property
     def contact_on(self) -> bool:
@@ -164,7 +173,8 @@ class Solving:
                               f"{self.obstacles!r}")
         object.__setattr__(self, "obstacles", tuple(str(o) for o in self.obstacles))
         _within(self.tolerance, *TOLERANCE, "solving.tolerance")
-        _count(self.max_iterations, 1, MAX_ITERATIONS, "solving.max_iterations")
+        if self.max_iterations is not None:
+            _count(self.max_iterations, 1, MAX_ITERATIONS, "solving.max_iterations")
         if self.actuation not in ACTUATIONS:
             raise OptionError(f"solving.actuation must be one of {', '.join(ACTUATIONS)}, "
                               f"got {self.actuation!r}")

@@ -116,13 +116,12 @@ def sweep_thin(job, sheet, pattern) -> tuple[list, object]:
 
 
 def newton_budget(solving) -> int:
-    """The run's Newton steps: ``solving.max_iterations`` when set, else the sheet's own
-    :data:`foldcore.sheet.solve.MAX_ITERATIONS` (the default budget is sized for the
-    thick strategies' thousands of cheap steps, not for Newton's tens)."""
-    from .sheet.solve import MAX_ITERATIONS
+    """The run's Newton steps: ``solving.max_iterations`` when given, else the sheet's own
+    :data:`foldcore.limits.SHEET_BUDGET` (a thick sheet's default budget is sized for
+    its strategies' thousands of cheap steps, not for Newton's tens)."""
+    from .limits import SHEET_BUDGET
 
-    given = solving.max_iterations != Solving.max_iterations  # the dataclass's default
-    return solving.max_iterations if given else MAX_ITERATIONS
+    return SHEET_BUDGET if solving.max_iterations is None else solving.max_iterations
 
 
 def thin_summary(job, pattern, result) -> str:

@@ -20,12 +20,13 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
+from ..limits import SHEET_BUDGET
 from ..linsolve import Factor, not_positive_definite
 from .build import HINGE, Sheet, tip_heights
 from .kernels import evaluate, fold_angles
 
 TOLERANCE = 1e-8       # largest relative force imbalance at equilibrium (SheetSolver.residual)
-MAX_ITERATIONS = 500
+MAX_ITERATIONS = SHEET_BUDGET
 MU_START, MU_FLOOR, MU_CEILING = 1e-3, 1e-9, 1e12
 ARMIJO, HALVINGS = 1e-4, 40
 ROUNDOFF = 1e-13  # energy changes below this share of the energy are rounding
