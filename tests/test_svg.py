@@ -198,6 +198,27 @@ def test_a_t_join_next_to_a_crossing_is_not_an_overlap(tmp_path):
     assert (crane.assignments == "M").any() and (crane.assignments == "V").any()
 
 
+@pytest.mark.parametrize("second", [206.25, 207.9, 212.0])
+def test_a_short_piece_between_two_creases_keeps_its_own_type(tmp_path, second):
+    """A mountain–valley–mountain line crossing two valleys 6 … 12 px apart (a maze's
+    short valley step): on the 3 px grid the short valley piece comes within reach
+    of the collinear mountain that ends at it, which only meets it at an end; it
+    stays a valley, and no overlap is reported (it was read as a mountain "drawn
+    over" it, and Origami Simulator's maze lost a few hundred valleys so)."""
+    body = ('<rect x="0" y="0" width="400" height="400" fill="none" stroke="#000"/>'
+            '<line x1="200" y1="0" x2="200" y2="400" stroke="#00f"/>'
+            f'<line x1="{second}" y1="0" x2="{second}" y2="400" stroke="#00f"/>'
+            '<line x1="0" y1="200" x2="200" y2="200" stroke="#f00"/>'
+            f'<line x1="200" y1="200" x2="{second}" y2="200" stroke="#00f"/>'
+            f'<line x1="{second}" y1="200" x2="400" y2="200" stroke="#f00"/>')
+    pattern, said = read_text(tmp_path, svg(body, size=400))
+    assert not any("drawn as two crease types" in line for line in said)
+    across = sorted((float(pattern.vertices[a, 0] + pattern.vertices[b, 0]), str(kind))
+                    for (a, b), kind in zip(pattern.edges, pattern.assignments)
+                    if kind != "B" and abs(pattern.vertices[a, 1] - pattern.vertices[b, 1]) < 1e-9)
+    assert [kind for _, kind in across] == ["M", "V", "M"], across
+
+
 CREASE = '<line x1="50" y1="0" x2="50" y2="100" stroke="#f00"/>'
 
 

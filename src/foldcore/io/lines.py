@@ -30,6 +30,10 @@ MAX_CLOSE_PAIRS = 1_000_000
 #: A piece lies along a segment if the sine of the angle between them is at most this
 #: (a piece near a crossing is near both segments but along one).
 PARALLEL = 0.1
+#: A segment a piece lies along covers at least this share of it (projected on the
+#: piece's line): a collinear neighbour, which the merging of ends on the grid can
+#: bring within reach, only meets it at an end.
+COVERED = 0.5
 #: Which of two crease types drawn over each other Origami Simulator keeps: the one
 #: its SVG reader lists first (it reads borders, then mountains, valleys, facet
 #: lines, hinges and cuts, and drops the later of two equal edges).
@@ -300,13 +304,16 @@ def piece_types(pieces, edges, vertices, segments, kinds, angles, owners, tol, s
     piece_ids, seg_ids = piece_ids[along <= 2.0 * tol], seg_ids[along <= 2.0 * tol]
     sine = np.abs(_cross(_unit(ends[piece_ids, 1] - ends[piece_ids, 0]),
                          _unit(segments[seg_ids, 1] - segments[seg_ids, 0])))
+    covers = _covered_share(ends[piece_ids], segments[seg_ids]) >= COVERED
     assignment = np.full(len(pieces), "", dtype="<U1")
     target = np.full(len(pieces), np.nan)
     owner = [None] * len(pieces)
     for p in np.unique(piece_ids):
         mine = np.flatnonzero(piece_ids == p)
         parallel = mine[sine[mine] <= PARALLEL]
-        chosen = parallel if len(parallel) else mine[[int(np.argmin(sine[mine]))]]
+        covering = parallel[covers[parallel]]  # not a collinear neighbour that ends at it
+        chosen = (covering if len(covering) else parallel if len(parallel)
+                  else mine[[int(np.argmin(sine[mine]))]])
         for s in seg_ids[chosen]:
             same = assignment[p] == kinds[s] and (np.isnan(target[p]) and np.isnan(angles[s])
                                                   or target[p] == angles[s])
@@ -326,6 +333,20 @@ def piece_types(pieces, edges, vertices, segments, kinds, angles, owners, tol, s
         s = int(tree.query_nearest(shapely.points(ends[p].mean(axis=0)))[0])
         assignment[p], target[p] = kinds[s], angles[s]
     return assignment.tolist(), [None if np.isnan(t) else float(t) for t in target]
+
+
+def _covered_share(pieces: np.ndarray, segments: np.ndarray) -> np.ndarray:
+    """(P,) the share of each piece ((P, 2, 2) ends) that its segment ((P, 2, 2)),
+    projected onto the piece's line, covers: 1 for a piece cut from the segment, 0 for
+    a collinear neighbour that only meets it at an end."""
+    start = pieces[:, 0]
+    axis = pieces[:, 1] - start
+    length = np.hypot(axis[:, 0], axis[:, 1])
+    unit = axis / np.maximum(length, 1e-300)[:, None]
+    a = np.einsum("ij,ij->i", segments[:, 0] - start, unit)
+    b = np.einsum("ij,ij->i", segments[:, 1] - start, unit)
+    overlap = np.minimum(np.maximum(a, b), length) - np.maximum(np.minimum(a, b), 0.0)
+    return np.clip(overlap, 0.0, None) / np.maximum(length, 1e-300)
 
 
 def _rank(kind: str) -> int:
