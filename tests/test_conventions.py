@@ -128,6 +128,26 @@ def test_a_folded_key_frame_reads_the_crease_pattern_frame_of_its_file_frames(in
     assert [m for m in said if "file_frames[1] (frame_classes: creasePattern)" in m]
 
 
+@pytest.mark.parametrize("label", [["creasePattern"], None])
+def test_a_key_frame_without_vertices_reads_the_pattern_from_its_file_frames(label):
+    """A file whose top level holds only file metadata and whose crease pattern is in
+    file_frames (labelled creasePattern, or the first frame with vertices) reads as
+    that frame, said once; without any frame of vertices it is refused naming the
+    missing key."""
+    cp = json.load(open("tests/data/real/diagonal-cp.fold"))
+    flat, _ = read_said(cp)
+    geometry = {k: v for k, v in cp.items() if k.startswith(("vertices_", "edges_", "faces_"))}
+    frame = {**geometry, **({"frame_classes": label} if label else {})}
+    top = {"file_spec": 1.1, "file_creator": "test",
+           "file_frames": [{"frame_title": "notes"}, frame]}
+    pattern, said = read_said(top)
+    np.testing.assert_allclose(pattern.vertices, flat.vertices)
+    np.testing.assert_array_equal(pattern.edges, flat.edges)
+    assert [m for m in said if "the key frame holds no vertices" in m and "file_frames[1]" in m]
+    with pytest.raises(PatternError, match="vertices_coords"):
+        read_said({"file_spec": 1.1, "file_frames": [{"frame_title": "notes"}]})
+
+
 def _edge_lengths_3d(d: dict, pattern) -> np.ndarray:
     xyz = np.array(d["vertices_coords"], dtype=float)
     xyz = np.column_stack([xyz, np.zeros(len(xyz))]) if xyz.shape[1] == 2 else xyz

@@ -128,26 +128,42 @@ ELEMENT_KEYS = ("vertices_", "edges_", "faces_")
 
 
 def crease_pattern_frame(d: dict, source: str) -> dict:
-    """The FOLD object whose frame is the crease pattern: ``d`` itself, or, when its
-    key frame is labelled ``foldedForm`` without ``vertices_flatUnfoldCoords`` and a
-    frame of its ``file_frames`` is labelled ``creasePattern``, that frame (said
-    once) over the key frame's file-level keys — and over its geometry too where
-    the frame inherits from it (``frame_inherit`` with ``frame_parent`` 0 or absent)."""
+    """The FOLD object whose frame is the crease pattern: ``d`` itself, or, from its
+    ``file_frames`` (said once, over the key frame's file-level keys — and over its
+    geometry too where the frame inherits from it: ``frame_inherit`` with
+    ``frame_parent`` 0 or absent):
+
+    * when its key frame is labelled ``foldedForm`` without
+      ``vertices_flatUnfoldCoords``, the frame labelled ``creasePattern``;
+    * when its key frame holds no vertices at all, the frame labelled
+      ``creasePattern``, else the first frame with ``vertices_coords``."""
     from .fold_json import ARRAY, has_class
 
     frames = d.get("file_frames")
-    if not has_class(d.get("frame_classes"), "foldedForm") or not isinstance(frames, ARRAY) \
-            or d.get("vertices_flatUnfoldCoords") is not None:
+    if not isinstance(frames, ARRAY):
         return d
-    for i, frame in enumerate(frames):
-        if isinstance(frame, dict) and has_class(frame.get("frame_classes"), "creasePattern"):
-            inherits = frame.get("frame_inherit") is True and frame.get("frame_parent", 0) == 0
-            base = {k: v for k, v in d.items() if k not in ("file_frames", "frame_classes")
-                    and (inherits or not str(k).split(":")[-1].startswith(ELEMENT_KEYS))}
-            note(source, f"the key frame is a folded form: the crease pattern is read from "
-                         f"file_frames[{i}] (frame_classes: creasePattern)")
-            return {**base, **frame}
-    return d
+    empty = d.get("vertices_coords") is None and d.get("vertices_flatUnfoldCoords") is None
+    folded = has_class(d.get("frame_classes"), "foldedForm") and \
+        d.get("vertices_flatUnfoldCoords") is None
+    if not (empty or folded):
+        return d
+    found = [(i, f) for i, f in enumerate(frames) if isinstance(f, dict)
+             and has_class(f.get("frame_classes"), "creasePattern")]
+    if not found and empty:
+        found = [(i, f) for i, f in enumerate(frames) if isinstance(f, dict)
+                 and f.get("vertices_coords") is not None]
+    if not found:
+        return d
+    i, frame = found[0]
+    inherits = frame.get("frame_inherit") is True and frame.get("frame_parent", 0) == 0
+    base = {k: v for k, v in d.items() if k not in ("file_frames", "frame_classes")
+            and (inherits or not str(k).split(":")[-1].startswith(ELEMENT_KEYS))}
+    why = "holds no vertices" if empty else "is a folded form"
+    label = "frame_classes: creasePattern" if has_class(frame.get("frame_classes"),
+                                                        "creasePattern") else "its first frame with vertices"
+    note(source, f"the key frame {why}: the crease pattern is read from "
+                 f"file_frames[{i}] ({label})")
+    return {**base, **frame}
 
 
 def note(source: str, message: str) -> None:
