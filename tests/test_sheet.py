@@ -33,6 +33,45 @@ def _evaluate(kind, size, p, nodes, rest, reference, hessian=False):
     return energy[0], gradient[0, :3 * size], hess[0, :3 * size, :3 * size]
 
 
+def test_a_sliver_corner_meets_a_barrier_that_keeps_its_facet_from_collapsing():
+    """A triangle whose corner closes below SLIVER of its rest angle: its energy is
+    the corner springs' plus k (SLIVER / r − 1)² per sliver corner (r = α / α₀),
+    growing without bound as the corner closes, and its gradient is still the
+    energy's (central differences); above SLIVER nothing is added."""
+    rest = np.array([[1.0, 1.0, np.pi - 2.0]])
+    nodes = np.array([[0, 1, 2, 0]])
+    k = 1.3
+
+    def triangle(alpha):  # corner 0 at the origin, its sides 1 long, angle alpha
+        return np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0],
+                         [np.cos(alpha), np.sin(alpha), 0.0]])
+
+    def springs(p):
+        angles = [np.arctan2(
+            np.linalg.norm(np.cross(p[j] - p[i], p[l] - p[i])), np.dot(p[j] - p[i], p[l] - p[i]))
+            for i, j, l in ((0, 1, 2), (1, 2, 0), (2, 0, 1))]
+        return 0.5 * k * np.sum((np.array(angles) - rest[0]) ** 2), angles
+
+    for alpha in (0.5, 0.05, 1e-3):
+        p = triangle(alpha)
+        energy, gradient, _ = _evaluate(TRIANGLE, 3, p, nodes, rest, np.zeros(1))
+        spring, angles = springs(p)
+        ratios = np.array(angles) / rest[0]
+        barrier = sum(k * (kernels.SLIVER / r - 1.0) ** 2 for r in ratios if r < kernels.SLIVER)
+        assert energy == pytest.approx(spring + barrier, rel=1e-12)
+        assert (barrier > 0) == (alpha / 1.0 < kernels.SLIVER)
+        h = 1e-7 * alpha
+        fd = np.zeros(9)
+        for i in range(9):
+            plus, minus = p.copy(), p.copy()
+            plus.ravel()[i] += h
+            minus.ravel()[i] -= h
+            fd[i] = (_evaluate(TRIANGLE, 3, plus, nodes, rest, np.zeros(1))[0]
+                     - _evaluate(TRIANGLE, 3, minus, nodes, rest, np.zeros(1))[0]) / (2 * h)
+        assert np.max(np.abs(gradient - fd)) <= 1e-5 * np.max(np.abs(fd))
+    assert energy > 1e3 * k  # closed to 1e-3 of its rest angle: the barrier dominates
+
+
 @pytest.mark.parametrize("kind,size", [(BAR, 2), (HINGE, 4), (TRIANGLE, 3)])
 def test_gradient_and_hessian_match_finite_differences(kind, size):
     rng = np.random.default_rng(kind)

@@ -15,7 +15,14 @@ at 60 %: 500 steps, 25 s, unsettled; with analytic bars 58 steps):
   the tip of the triangle left of it, ``d`` of the one right of it; ``φ`` the
   fold angle (radians, valley > 0 for a counter-clockwise sheet seen from +z),
   unwrapped to within π of a reference so a fold past ±180° keeps counting;
-* **triangle** ``(a, b, c)``: ``½ k Σ (α − α₀)²`` over its three corner angles.
+* **triangle** ``(a, b, c)``: ``½ k Σ (α − α₀)²`` over its three corner angles,
+  plus ``k (s / r − 1)²`` for a corner closed below ``s`` = :data:`SLIVER` of its
+  rest angle (``r = α / α₀``): a barrier that keeps a facet from collapsing. A
+  crease's force on a facet grows as 1 / its height, so a facet squashed flat
+  (heights of 1e-10) holds Newton's steps at μ ~ 1e9 for the rest of the
+  budget; Origami Simulator switches such a crease off instead, which makes
+  the energy jump and stops a line search. Facets of a fold that keep their
+  shape never meet it.
 
 Units: the sheet's normalised frame (lengths / its bounding radius), angles in
 radians. All kernels take positions ``x`` (N, 3).
@@ -36,6 +43,9 @@ STEP = 1e-8  # forward-difference step of the Hessians × the element's size (�
 #: A triangle lower than this (normalised units) has collapsed: Origami Simulator's
 #: tolerance, below which it disables a crease; the smallest element size a step scales to.
 COLLAPSED = 1e-6
+#: A corner closed below this share of its rest angle is a sliver: the barrier
+#: k (SLIVER / r − 1)², r = α / α₀, keeps its triangle from collapsing.
+SLIVER = 0.1
 
 
 @njit(cache=True, inline="always")
@@ -136,8 +146,8 @@ def _hinge_gradient(p, k, target, reference, g):
 
 @njit(cache=True)
 def _corner(p, i, j, l, k, rest, g):
-    """Add ½ k (α − rest)² of the corner at p[i] (between p[j], p[l]) and its
-    gradient into g; returns the energy."""
+    """Add ½ k (α − rest)² of the corner at p[i] (between p[j], p[l]), plus the sliver
+    barrier below ``SLIVER`` × rest, and its gradient into g; returns the energy."""
     u = _vec(p, j, i)
     v = _vec(p, l, i)
     n = _cross(u, v)
@@ -149,13 +159,18 @@ def _corner(p, i, j, l, k, rest, g):
     n = (n[0] / s, n[1] / s, n[2] / s)
     nu, nv = _cross(n, u), _cross(n, v)
     f = k * (alpha - rest)
+    barrier = 0.0
+    r = alpha / rest if rest > 0.0 else 1.0
+    if r < SLIVER:  # a sliver: k (SLIVER / r − 1)², its derivative in α added to f
+        barrier = k * (SLIVER / r - 1.0) ** 2
+        f -= 2.0 * k * (SLIVER / r - 1.0) * SLIVER / (r * r * rest)
     for c in range(3):
         gj = -nu[c] / uu
         gl = nv[c] / vv
         g[j, c] += f * gj
         g[l, c] += f * gl
         g[i, c] -= f * (gj + gl)
-    return 0.5 * k * (alpha - rest) ** 2
+    return 0.5 * k * (alpha - rest) ** 2 + barrier
 
 
 @njit(cache=True)
