@@ -124,6 +124,7 @@ def test_a_fold_that_squashes_facets_settles():
     solver = SheetSolver(sheet, 60.0, pattern_edges=loaded.pattern.n_edges)
     fold = solver.run(max_iterations=200)
     assert fold.converged and fold.residual < 1e-8
+    assert fold.sliver_corners >= 1  # the barrier holds, and the result counts it
     triangles = sheet.kinds == TRIANGLE
     corners = sheet.nodes[triangles][:, :3]
     for c, (i, j, l) in enumerate(((0, 1, 2), (1, 2, 0), (2, 0, 1))):
@@ -131,6 +132,19 @@ def test_a_fold_that_squashes_facets_settles():
         v = solver.x[corners[:, l]] - solver.x[corners[:, i]]
         angle = np.arctan2(np.linalg.norm(np.cross(u, v), axis=1), np.einsum("ij,ij->i", u, v))
         assert np.all(angle >= 0.5 * SLIVER * sheet.rest[triangles][:, c])
+
+
+def test_corners_held_by_the_sliver_barrier_are_said_and_reported(tmp_path, miura_file):
+    report = tmp_path / "r.json"
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        foldcore.simulate(REAL + "traditionalCrane.svg", solving={"fold_percent": 60},
+                          outputs={"report": report})
+        foldcore.simulate(miura_file, outputs={"report": tmp_path / "m.json"})
+    said = [str(w.message) for w in caught if "sliver barrier" in str(w.message)]
+    held = json.loads(report.read_text())["sheet"]["sliver_corners"]
+    assert held >= 1 and len(said) == 1 and said[0].startswith(REAL + "traditionalCrane.svg")
+    assert json.loads((tmp_path / "m.json").read_text())["sheet"]["sliver_corners"] == 0
 
 
 def test_a_sheet_whose_bars_dwarf_its_springs_settles():

@@ -127,9 +127,16 @@ def newton_budget(solving) -> int:
 def thin_summary(job, pattern, result) -> str:
     """The run's one-line summary; the warnings it calls for are issued."""
     from .outputs import run_summary
+    from .sheet.kernels import SLIVER
 
     summary, said = run_summary(result, pattern, job.source, job.solving.fold_percent,
                                 model="sheet")
+    if result.sliver_corners:
+        n = result.sliver_corners
+        said.append(f"{job.source}: {n} facet corner{'s are' if n > 1 else ' is'} held open "
+                    f"by the sliver barrier (closed to {SLIVER:g} of the rest angle): the "
+                    "facets there would collapse; Origami Simulator switches their creases "
+                    "off instead, so its shape differs there")
     for text in said:
         warnings.warn(text, RunWarning, stacklevel=3)
     return summary

@@ -53,6 +53,7 @@ def sheet_report(fold, pattern, sheet, settings: dict) -> dict:
                   "creases": int(np.count_nonzero(sprung & (sheet.hinge_edge >= 0))),
                   "facet_hinges": facets,
                   "free_hinges": int(np.count_nonzero(~sprung)),
+                  "sliver_corners": int(fold.sliver_corners),
                   "radius_mm": float(sheet.radius),
                   "stiffness": asdict(sheet.constants)},
         "timings_s": {k: float(v) for k, v in fold.timings_s.items()},

@@ -22,8 +22,8 @@ import scipy.sparse as sp
 
 from ..limits import SHEET_BUDGET
 from ..linsolve import Factor, not_positive_definite
-from .build import HINGE, Sheet, tip_heights
-from .kernels import evaluate, fold_angles
+from .build import HINGE, TRIANGLE, Sheet, tip_heights
+from .kernels import SLIVER, evaluate, fold_angles
 
 TOLERANCE = 1e-8       # largest relative force imbalance at equilibrium (SheetSolver.residual)
 MAX_ITERATIONS = SHEET_BUDGET
@@ -53,6 +53,9 @@ class SheetFold:
     energy : float, normalised units
     timings_s : dict, seconds: ``solve`` (the Newton steps); the caller may add
         ``setup`` and ``total``
+    sliver_corners : int, triangle corners closed below
+        :data:`~.kernels.SLIVER` of their rest angle at the end: held open by the
+        sliver barrier, where the facet would otherwise collapse
     """
 
     positions: np.ndarray
@@ -65,6 +68,7 @@ class SheetFold:
     residual: float
     energy: float
     timings_s: dict
+    sliver_corners: int = 0
 
 
 class Assembly:
@@ -322,7 +326,21 @@ def _fold(sheet: Sheet, energy: Energy, x, iterations, reason, residual, value, 
     alias = sheet.edge_alias[:count]
     per_edge[:len(alias)], targets[:len(alias)] = per_edge[alias], targets[alias]
     return SheetFold(sheet.to_mm(x), per_edge, targets, angles, iterations,
-                     reason == "converged", reason, residual, value, {"solve": seconds})
+                     reason == "converged", reason, residual, value, {"solve": seconds},
+                     sliver_corners=sliver_corners(sheet, x))
+
+
+def sliver_corners(sheet: Sheet, x: np.ndarray) -> int:
+    """How many triangle corners of the sheet at ``x`` (N, 3) are closed below
+    :data:`~.kernels.SLIVER` of their rest angle (the sliver barrier's range)."""
+    triangles = sheet.kinds == TRIANGLE
+    corners, rest = sheet.nodes[triangles][:, :3], sheet.rest[triangles]
+    count = 0
+    for c, (i, j, l) in enumerate(((0, 1, 2), (1, 2, 0), (2, 0, 1))):
+        u, v = x[corners[:, j]] - x[corners[:, i]], x[corners[:, l]] - x[corners[:, i]]
+        angle = np.arctan2(np.linalg.norm(np.cross(u, v), axis=1), np.einsum("ij,ij->i", u, v))
+        count += int(np.count_nonzero(angle < SLIVER * rest[:, c]))
+    return count
 
 
 def _hinge_references(sheet: Sheet, energy: Energy) -> np.ndarray:
