@@ -32,7 +32,8 @@ from .errors import FoldcoreError
 from . import interrupts, result_commands
 from .limits import (CELL_RATIO, GROUND_RATIO, LENGTH_MM, MARGIN_RATIO, MAX_ELASTIC_VERTICES,
                      MAX_DRIVEN, MAX_ITERATIONS, MAX_MESH_VERTICES, SHEET_BUDGET, STROKE_RATIO,
-                     SUBDIVISIONS, THICK_BUDGET, THICKNESS_RATIO, TOLERANCE, UNITLESS_SHEET_MM, WIDTH_RATIO)
+                     SUBDIVISIONS, THICK_BUDGET, THICKNESS_RATIO, TOLERANCE,
+                     UNITLESS_SHEET_MM, WIDTH_RATIO)
 from .options import CONTACT_CHOICES, MAX_FPS, MAX_FRAMES
 from .study import commands as study_commands
 from .strategies import DEFAULT_SOLVER, SOLVERS

@@ -159,8 +159,8 @@ def crease_pattern_frame(d: dict, source: str) -> dict:
     base = {k: v for k, v in d.items() if k not in ("file_frames", "frame_classes")
             and (inherits or not str(k).split(":")[-1].startswith(ELEMENT_KEYS))}
     why = "holds no vertices" if empty else "is a folded form"
-    label = "frame_classes: creasePattern" if has_class(frame.get("frame_classes"),
-                                                        "creasePattern") else "its first frame with vertices"
+    labelled = has_class(frame.get("frame_classes"), "creasePattern")
+    label = "frame_classes: creasePattern" if labelled else "its first frame with vertices"
     note(source, f"the key frame {why}: the crease pattern is read from "
                  f"file_frames[{i}] ({label})")
     return {**base, **frame}

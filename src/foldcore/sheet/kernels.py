@@ -19,10 +19,11 @@ at 60 %: 500 steps, 25 s, unsettled; with analytic bars 58 steps):
   plus ``k (s / r − 1)²`` for a corner closed below ``s`` = :data:`SLIVER` of its
   rest angle (``r = α / α₀``): a barrier that keeps a facet from collapsing. A
   crease's force on a facet grows as 1 / its height, so a facet squashed flat
-  (heights of 1e-10) holds Newton's steps at μ ~ 1e9 for the rest of the
-  budget; Origami Simulator switches such a crease off instead, which makes
-  the energy jump and stops a line search. Facets of a fold that keep their
-  shape never meet it.
+  (heights of 1e-8 … 1e-11) held Newton's damping at μ = 1e8 … 1e10 for the
+  rest of the budget; Origami Simulator switches such a crease off instead,
+  which makes the energy jump and stops a line search
+  (`docs/architecture.md#facets-that-would-collapse`). Facets of a fold that
+  keep their shape never meet it.
 
 Units: the sheet's normalised frame (lengths / its bounding radius), angles in
 radians. All kernels take positions ``x`` (N, 3).
