@@ -143,7 +143,7 @@ def fold(path, *, hinges=None, reading=None, thickening=None, solving=None, outp
     else:
         sim.set_fold_percent(s.fold_percent)
         try:
-            result = sim.run(tolerance=s.tolerance, max_iterations=s.budget,
+            result = sim.run(tolerance=s.tolerance, max_iterations=s.budget(),
                              callback=callback)
         except KeyboardInterrupt:  # the last complete iterate is a result too
             result, interrupted = sim.result(False, "interrupted"), True
@@ -286,7 +286,7 @@ def run_settings(job: Job, thickness: float, mesh, sim) -> dict:
     """What the report records of the run's settings."""
     s, t = job.solving, job.thickening
     return {"pattern": job.source, "fold_percent": s.fold_percent, "solver": s.solver,
-            "tolerance": s.tolerance, "max_iterations": s.budget,
+            "tolerance": s.tolerance, "max_iterations": s.budget(),
             "subdivisions": t.subdivisions, "thickness_mm": thickness,
             "hinge": sorted(set(mesh.hinge_model) - {""}), "actuation": s.actuation,
             "branch_floor_deg": s.branch_floor, "elastic_cells_mm": t.elastic_cells,
@@ -302,7 +302,7 @@ def _animate(sim, s, out) -> list:
 
     percents = percent_schedule(out.frames, s.fold_percent)
     movie = animate(sim, percents, out.animate, fps=out.fps, tolerance=s.tolerance,
-                    max_iterations=s.budget)
+                    max_iterations=s.budget())
     return _said_unconverged(list(zip(map(float, percents), movie.results)))
 
 
@@ -312,7 +312,7 @@ def _sweep(sim, s, out) -> list:
 
     percents = percent_schedule(out.frames, s.fold_percent)
     results = fold_sweep(sim, percents, tolerance=s.tolerance,
-                         max_iterations=s.budget, progress=False)
+                         max_iterations=s.budget(), progress=False)
     return _said_unconverged(list(zip(map(float, percents), results)))
 
 

@@ -114,7 +114,7 @@ class Solving:
         (:data:`foldcore.limits.MAX_ITERATIONS`); None (default): the model's own,
         :data:`foldcore.limits.THICK_BUDGET` iterations of a thick sheet's strategy or
         :data:`foldcore.limits.SHEET_BUDGET` Newton steps of a thin sheet
-        (:attr:`budget`).
+        (:meth:`budget`).
     actuation : {"equal", "angle"}
     branch_floor : float
         Degrees ≥ 0 passive M/V creases are held on their assigned side while a
@@ -147,11 +147,11 @@ class Solving:
     obstacles: tuple = ()
     ground: float | None = None
 
-    @property
-    def budget(self) -> int:
-        """A thick sheet's iteration budget: ``max_iterations``, or
-        :data:`foldcore.limits.THICK_BUDGET`."""
-        return THICK_BUDGET if self.max_iterations is None else self.max_iterations
+    def budget(self, default: int = THICK_BUDGET) -> int:
+        """The run's iteration budget: ``max_iterations`` when given, else ``default``
+        (:data:`foldcore.limits.THICK_BUDGET` for a thick sheet's strategies,
+        :data:`foldcore.limits.SHEET_BUDGET` for a thin sheet's Newton steps)."""
+        return default if self.max_iterations is None else self.max_iterations
 
     @property
     def contact_on(self) -> bool:

@@ -16,6 +16,7 @@ import time
 import warnings
 
 from .errors import RunWarning
+from .limits import SHEET_BUDGET
 from .options import OptionError, Solving, Thickening
 
 #: The line a thin-sheet run says first.
@@ -80,7 +81,7 @@ def run_thin(job, loaded, on_start=None, callback=None):
         result.timings_s["solve"] = sum(r.timings_s["solve"] for _, r in sweep)
     else:
         try:
-            result = solver.run(s.tolerance, newton_budget(s), _callback(callback))
+            result = solver.run(s.tolerance, s.budget(SHEET_BUDGET), _callback(callback))
         except KeyboardInterrupt:
             result, interrupted = solver.result("interrupted"), True
     result.timings_s.update(setup=setup, total=setup + result.timings_s["solve"])
@@ -101,7 +102,7 @@ def sweep_thin(job, sheet, pattern) -> tuple[list, object]:
     sweep, start, steps = [], None, 0
     for percent in percent_schedule(out.frames, s.fold_percent):
         solver = SheetSolver(sheet, float(percent), start=start, pattern_edges=pattern.n_edges)
-        fold = solver.run(s.tolerance, newton_budget(s))
+        fold = solver.run(s.tolerance, s.budget(SHEET_BUDGET))
         steps = fold.iterations = steps + fold.iterations  # from the sweep's start, as thick
         sweep.append((float(percent), fold))
         start = fold.positions
@@ -113,15 +114,6 @@ def sweep_thin(job, sheet, pattern) -> tuple[list, object]:
                                      titles=frame_titles(p for p, _ in sweep))
         write_animation(out.animate, frames, out.fps)
     return sweep, solver
-
-
-def newton_budget(solving) -> int:
-    """The run's Newton steps: ``solving.max_iterations`` when given, else the sheet's own
-    :data:`foldcore.limits.SHEET_BUDGET` (a thick sheet's default budget is sized for
-    its strategies' thousands of cheap steps, not for Newton's tens)."""
-    from .limits import SHEET_BUDGET
-
-    return SHEET_BUDGET if solving.max_iterations is None else solving.max_iterations
 
 
 def thin_summary(job, pattern, result) -> str:
@@ -173,5 +165,5 @@ def thin_settings(job) -> dict:
     """What the report records of a thin-sheet run's settings."""
     s = job.solving
     return {"pattern": job.source, "model": "sheet", "fold_percent": s.fold_percent,
-            "tolerance": s.tolerance, "max_iterations": newton_budget(s),
+            "tolerance": s.tolerance, "max_iterations": s.budget(SHEET_BUDGET),
             "thickness_mm": None}

@@ -26,7 +26,6 @@ from .build import HINGE, TRIANGLE, Sheet, tip_heights
 from .kernels import SLIVER, evaluate, fold_angles
 
 TOLERANCE = 1e-8       # largest relative force imbalance at equilibrium (SheetSolver.residual)
-MAX_ITERATIONS = SHEET_BUDGET
 MU_START, MU_FLOOR, MU_CEILING = 1e-3, 1e-9, 1e12
 ARMIJO, HALVINGS = 1e-4, 40
 ROUNDOFF = 1e-13  # energy changes below this share of the energy are rounding
@@ -149,7 +148,7 @@ class Energy:
 
 
 def fold_sheet(sheet: Sheet, fold_percent: float = 100.0, start: np.ndarray | None = None,
-               tolerance: float = TOLERANCE, max_iterations: int = MAX_ITERATIONS,
+               tolerance: float = TOLERANCE, max_iterations: int = SHEET_BUDGET,
                backend: str = "auto", pattern_edges: int | None = None) -> SheetFold:
     """Settle ``sheet`` at ``fold_percent`` (of every crease's target), from flat or
     from ``start`` (V, 3) mm, one per pattern vertex; see the module docstring and
@@ -201,7 +200,7 @@ class SheetSolver:
         imbalance = np.linalg.norm(self.gradient.reshape(-1, 3), axis=1)
         return float(np.max(imbalance / (meeting + self.unit_force)))
 
-    def run(self, tolerance: float = TOLERANCE, max_iterations: int = MAX_ITERATIONS,
+    def run(self, tolerance: float = TOLERANCE, max_iterations: int = SHEET_BUDGET,
             callback=None) -> SheetFold:
         """Steps until the largest force is below ``tolerance`` (``"converged"``), no
         step lowers the energy (``"stalled"``), ``max_iterations`` steps

@@ -96,7 +96,7 @@ def _fold_point(path: str, hinges, point: dict, state, metric, keep: bool):
     s = job.solving
     sim.set_fold_percent(s.fold_percent)
     began = time.perf_counter()
-    result = sim.run(tolerance=s.tolerance, max_iterations=s.budget,
+    result = sim.run(tolerance=s.tolerance, max_iterations=s.budget(),
                      callback=getattr(metric, "watch", None))
     row = {**figures(result, loaded.pattern, mesh), "run_s": time.perf_counter() - began}
     row.update(iterations=sim.iterations - before, start=start, error="",
