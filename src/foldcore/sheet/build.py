@@ -161,13 +161,14 @@ def _hinges(triangles: np.ndarray):
     return np.array(hinges, dtype=np.int64).reshape(-1, 4), np.array(bars, dtype=np.int64)
 
 
-def _corner_angles(p: np.ndarray) -> np.ndarray:
-    """(T, 3) corner angles (radians) of triangles with points p (T, 3, 2)."""
+def corner_angles(p: np.ndarray) -> np.ndarray:
+    """(T, 3) corner angles (radians) of triangles with points p (T, 3, 3), corner i
+    between the sides to points i + 1 and i + 2."""
     out = np.empty(p.shape[:2])
     for i in range(3):
         u = p[:, (i + 1) % 3] - p[:, i]
         v = p[:, (i + 2) % 3] - p[:, i]
-        out[:, i] = np.arctan2(np.abs(u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0]),
+        out[:, i] = np.arctan2(np.linalg.norm(np.cross(u, v), axis=1),
                                np.einsum("ij,ij->i", u, v))
     return out
 
@@ -325,7 +326,7 @@ def _assemble(nodes_of, centre, radius, cut, hinges, hinge_edge, targets, spring
     rest = np.zeros((len(k), 3))
     rest[:nb, 0] = length
     rest[nb:nb + nh, 0] = targets[sprung]
-    rest[nb + nh:] = _corner_angles(flat[triangles][:, :, :2])
+    rest[nb + nh:] = corner_angles(flat[triangles])
     hinge_elements = np.full(len(hinges), -1, dtype=np.int64)
     hinge_elements[sprung] = nb + np.arange(nh)
     return Sheet(flat, vertex_ids, merging.merged, merging.merged_at, merging.edge_alias,

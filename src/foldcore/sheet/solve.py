@@ -22,7 +22,7 @@ import scipy.sparse as sp
 
 from ..limits import SHEET_BUDGET
 from ..linsolve import Factor, not_positive_definite
-from .build import HINGE, TRIANGLE, Sheet, tip_heights
+from .build import HINGE, TRIANGLE, Sheet, corner_angles, tip_heights
 from .kernels import SLIVER, evaluate, fold_angles
 
 TOLERANCE = 1e-8       # largest relative force imbalance at equilibrium (SheetSolver.residual)
@@ -333,13 +333,8 @@ def sliver_corners(sheet: Sheet, x: np.ndarray) -> int:
     """How many triangle corners of the sheet at ``x`` (N, 3) are closed below
     :data:`~.kernels.SLIVER` of their rest angle (the sliver barrier's range)."""
     triangles = sheet.kinds == TRIANGLE
-    corners, rest = sheet.nodes[triangles][:, :3], sheet.rest[triangles]
-    count = 0
-    for c, (i, j, l) in enumerate(((0, 1, 2), (1, 2, 0), (2, 0, 1))):
-        u, v = x[corners[:, j]] - x[corners[:, i]], x[corners[:, l]] - x[corners[:, i]]
-        angle = np.arctan2(np.linalg.norm(np.cross(u, v), axis=1), np.einsum("ij,ij->i", u, v))
-        count += int(np.count_nonzero(angle < SLIVER * rest[:, c]))
-    return count
+    angles = corner_angles(x[sheet.nodes[triangles][:, :3]])
+    return int(np.count_nonzero(angles < SLIVER * sheet.rest[triangles]))
 
 
 def _hinge_references(sheet: Sheet, energy: Energy) -> np.ndarray:
