@@ -341,8 +341,7 @@ def _covered_share(pieces: np.ndarray, segments: np.ndarray) -> np.ndarray:
     a collinear neighbour that only meets it at an end."""
     start = pieces[:, 0]
     axis = pieces[:, 1] - start
-    length = np.hypot(axis[:, 0], axis[:, 1])
-    unit = axis / np.maximum(length, 1e-300)[:, None]
+    length, unit = np.hypot(axis[:, 0], axis[:, 1]), _unit(axis)
     a = np.einsum("ij,ij->i", segments[:, 0] - start, unit)
     b = np.einsum("ij,ij->i", segments[:, 1] - start, unit)
     overlap = np.minimum(np.maximum(a, b), length) - np.maximum(np.minimum(a, b), 0.0)
