@@ -23,23 +23,19 @@ import numpy as np
 import scipy.sparse as sp
 
 from .obstacles import ObstacleContacts
-from .solids import PanelSolids
+from .solids import JoinedZones, PanelSolids
 
 #: Share of a straight-line step taken up to the first touch (IPC's 0.8–0.9).
 CCD_RESCALING = 0.9
-#: Joined panels touch with their geometry scaled by 1 − this about its centroid
-#: (:meth:`~.solids.PanelSolids.shrunk`): faces that meet by design stay apart, and
-#: two joined panels can overlap by at most this share of their size.
+#: Joined panels touch with their faces this share of H closer together
+#: (:class:`~.solids.JoinedZones`): faces that meet by design at a flat fold stay apart.
 JOINED_SHARE = 2e-5
+#: Depth of the band along a crease in which its hinge, not contact, decides how
+#: its two panels meet (:class:`~.solids.JoinedZones`), × the crease's hinge width.
+HINGE_ZONE = 1.0
 #: κ doubles while the smallest gap of unjoined pairs is below this share of d̂ and
 #: shrinking (IPC's adaptive stiffness), up to ``MAX_STIFFENING`` × its start.
 TIGHT_GAP = 1e-3
-#: Joined panels are checked once their crease is folded past this angle (their
-#: normals' dot below its cosine), toward a flat fold: before, their hinge holds them, and
-#: an axis hinge turning into its pivot lets their inner edges meet within less
-#: than the shrunk geometry's margin (a Miura's zig-zag creases past 2·atan(W/H)).
-JOINED_FROM_DEG = 150.0
-JOINED_FROM = float(np.cos(np.radians(JOINED_FROM_DEG)))
 MAX_STIFFENING = 1e8
 
 
@@ -132,9 +128,12 @@ class ContactModel:
                  settings: ContactSettings | None = None, obstacles=()):
         self.settings = settings or ContactSettings()
         self.solids = PanelSolids(mesh, pattern)
+        self.zones = JoinedZones(self.solids, mesh, pattern,
+                                 HINGE_ZONE * mesh.hinge_width[self.solids.joined_crease],
+                                 JOINED_SHARE)
         self.dhat = self.settings.activation * float(mesh.thickness)
         self.kappa = self.settings.stiffness * float(reference_weight)
-        #: d̂ of joined pairs, mm: half the gap their shrunk faces keep at a flat fold
+        #: d̂ of joined pairs, mm: half the gap their thinned faces keep at a flat fold
         self.dhat_joined = 0.5 * JOINED_SHARE * float(mesh.thickness)
         self.n_vertices = mesh.n_vertices
         self._rest = mesh.rest_positions
@@ -156,6 +155,26 @@ class ContactModel:
                 # factor ln: of the variants tried (×1, ×d̂/d̂_j, ×(d̂/d̂_j)²) the fewest steps
                 True: ipctk.BarrierPotential(self.dhat_joined,
                                              self.kappa * self.dhat / self.dhat_joined)}
+
+    def twin(self, mesh, pattern) -> "ContactModel":
+        """This contact on another thickening of the same pattern (the rigid
+        strategy's coarse twin: the same panels with fewer strip vertices): the same
+        settings, κ and obstacles."""
+        obstacles = self.obstacles.obstacles if self.obstacles is not None else ()
+        return ContactModel(mesh, pattern, self.kappa / self.settings.stiffness,
+                            self.settings, obstacles)
+
+    def take_over(self, other: "ContactModel", panels: np.ndarray) -> None:
+        """Go on from ``other``'s run (a twin's, :meth:`twin`): its κ and the pairs
+        that cut its last step short, its panel p being this model's panels[p]."""
+        if other.kappa != self.kappa:
+            self.kappa = other.kappa
+            self._potential = self._potentials()
+            if self.obstacles is not None:
+                self.obstacles.potential = self._potential[False]
+        self._last_gap = other._last_gap
+        self.blocking = [tuple(sorted((int(panels[a]), int(panels[b]))))
+                         for a, b in other.blocking]
 
     def stiffen(self, state: "ContactState") -> bool:
         """IPC's adaptive stiffness: doubles κ where the smallest gap of unjoined pairs
@@ -184,49 +203,68 @@ class ContactModel:
         return pairs
 
     def _joined_near(self, x: np.ndarray, margin: float):
-        """((K, 2) joined pairs folded past ``JOINED_FROM_DEG`` (their normals'
-        dihedral) whose shrunk panels are not proved ``margin`` apart, the shrunk
-        positions or None where no joined pair is folded that far)."""
-        s = self.solids
-        pairs = s.joined_pairs
-        if not len(pairs):
-            return pairs, None
-        normal, _ = s.normals(x)  # scaling about the centroid keeps the normals
-        folded = np.einsum("ij,ij->i", normal[pairs[:, 0]], normal[pairs[:, 1]]) < JOINED_FROM
-        pairs, edges = pairs[folded], s.joined_edge[folded]
-        if not len(pairs):
-            return pairs, None
-        shrunk = s.shrunk(x, JOINED_SHARE)
-        return pairs[s.gap_bounds(shrunk, pairs, edges) < margin], shrunk
+        """((K,) indices of the joined pairs whose trimmed panels
+        (:class:`~.solids.JoinedZones`) are not proved ``margin`` apart, their
+        trimmed positions or None where no pair is joined)."""
+        zones = self.zones
+        if not len(zones.pairs):
+            return np.zeros(0, dtype=np.int64), None
+        y = zones.positions(x)
+        which = np.arange(len(zones.pairs))
+        return which[zones.gap_bounds(y, which) < margin], y
 
-    def _pairs(self, x: np.ndarray, joined: bool):
-        """[(joined, pairs, positions)] to evaluate at x: unjoined pairs within d̂ on
-        the panels as they are, joined pairs (where ``joined``) within their d̂ on
-        the shrunk panels."""
-        out = [(False, self.candidates(x, self.dhat), x)]
+    def _terms_at(self, x: np.ndarray, joined: bool):
+        """[(joined, (a, b), collision mesh, model vertex ids, pull-back, local
+        positions)] of every pair to evaluate at x: unjoined pairs within d̂ on the
+        panels as they are, joined pairs (where ``joined``) within their d̂ on their
+        trimmed panels."""
+        out = []
+        for a, b in self.candidates(x, self.dhat):
+            mesh, ids, pull = self._pair_mesh(int(a), int(b))
+            out.append((False, (a, b), mesh, ids, pull, np.asfortranarray(x[ids])))
         if joined:
-            pairs, shrunk = self._joined_near(x, self.dhat_joined)
-            out.append((True, pairs, shrunk))
+            which, y = self._joined_near(x, self.dhat_joined)
+            for k in which:
+                mesh, ids, pull = self._zone_mesh(int(k))
+                out.append((True, tuple(self.zones.pairs[k]), mesh, ids, pull,
+                            np.asfortranarray(y[self.zones.rows(int(k))])))
         return out
 
-    def _pair_mesh(self, a: int, b: int, joined: bool):
-        """(collision mesh, model vertex ids, pull-back) of panels a and b, cached; the
-        pull-back maps the pair's (3n,) dofs of its (shrunk) geometry to x (None:
-        the identity)."""
+    def _pair_mesh(self, a: int, b: int):
+        """(collision mesh, model vertex ids, None) of panels a and b, cached."""
         key = (a, b)
         if key not in self._meshes:
-            ipctk = _ipctk()
             s = self.solids
             ids = s.pair_vertices(a, b)
-            n_a = s.ptr[a + 1] - s.ptr[a]
-            faces = np.vstack([s.triangles[a], s.triangles[b] + n_a]).astype(np.int32)
-            mesh = ipctk.CollisionMesh(np.asfortranarray(self._rest[ids]),
-                                       ipctk.edges(faces), faces)
-            mesh.can_collide = ipctk.make_vertex_patches_filter(
-                np.repeat([0, 1], [n_a, len(ids) - n_a]).astype(np.int32))
-            self._meshes[key] = (mesh, ids, _shrink_map(n_a, len(ids) - n_a)
-                                 if joined else None)
+            self._meshes[key] = (self._collision_mesh(self._rest[ids], s.triangles[a],
+                                                      s.triangles[b]), ids, None)
         return self._meshes[key]
+
+    def _zone_mesh(self, k: int):
+        """(collision mesh, model vertex ids, pull-back) of joined pair k's trimmed
+        panels, cached; the pull-back maps the pair's (3n,) dofs to its trimmed
+        corners'."""
+        key = ("joined", k)
+        if key not in self._meshes:
+            z, s = self.zones, self.solids
+            a, b = (int(p) for p in z.pairs[k])
+            mesh = self._collision_mesh(z.rest[z.rows(k)], s.triangles[a], s.triangles[b])
+            ids, weights = z.pair(k)
+            self._meshes[key] = (mesh, ids, np.kron(weights, np.eye(3)))
+        return self._meshes[key]
+
+    @staticmethod
+    def _collision_mesh(rest: np.ndarray, faces_a: np.ndarray, faces_b: np.ndarray):
+        """ipctk's collision mesh of two prisms: rest (n, 3) their corners (a's
+        first), faces_a/faces_b their triangles (local indices), each body only
+        against the other."""
+        ipctk = _ipctk()
+        n_a = int(faces_a.max()) + 1
+        faces = np.vstack([faces_a, faces_b + n_a]).astype(np.int32)
+        mesh = ipctk.CollisionMesh(np.asfortranarray(rest), ipctk.edges(faces), faces)
+        mesh.can_collide = ipctk.make_vertex_patches_filter(
+            np.repeat([0, 1], [n_a, len(rest) - n_a]).astype(np.int32))
+        return mesh
 
     # -------------------------------------------------------- the barrier
     def state(self, x: np.ndarray, joined: bool = True) -> ContactState:
@@ -235,20 +273,17 @@ class ContactModel:
         them)."""
         ipctk = _ipctk()
         pairs, gaps, energy, terms, kinds = [], [], 0.0, [], []
-        for joined, candidates, positions in self._pairs(x, joined):
+        for joined, (a, b), mesh, ids, pull, local in self._terms_at(x, joined):
             dhat, potential = (self.dhat_joined if joined else self.dhat), self._potential[joined]
-            for a, b in candidates:
-                mesh, ids, pull = self._pair_mesh(int(a), int(b), joined)
-                local = np.asfortranarray(positions[ids])
-                collisions = ipctk.NormalCollisions()
-                collisions.build(mesh, local, dhat)
-                if not len(collisions):
-                    continue
-                pairs.append((a, b))
-                kinds.append(joined)
-                gaps.append(np.sqrt(collisions.compute_minimum_distance(mesh, local)))
-                energy += float(potential(collisions, mesh, local))
-                terms.append((ids, collisions, mesh, local, potential, pull))
+            collisions = ipctk.NormalCollisions()
+            collisions.build(mesh, local, dhat)
+            if not len(collisions):
+                continue
+            pairs.append((a, b))
+            kinds.append(joined)
+            gaps.append(np.sqrt(collisions.compute_minimum_distance(mesh, local)))
+            energy += float(potential(collisions, mesh, local))
+            terms.append((ids, collisions, mesh, local, potential, pull))
         pairs = np.array(pairs, dtype=np.int64).reshape(-1, 2)
         state = ContactState(pairs, np.array(gaps, dtype=float), energy, terms,
                              joined=np.array(kinds, dtype=bool), _obstacle_of=[-1] * len(terms))
@@ -305,10 +340,11 @@ class ContactModel:
         x0 → x0 + t (x1 − x0) is collision-free (additive CCD, rescaled by
         ``CCD_RESCALING``). Joined pairs turn about the hinge they share, whose
         chords cut across it, so a straight-line check would stop them where the
-        hinge keeps their faces a hair apart; their shrunk geometry is checked
-        at x1 instead (½ where it intersects): two panels a hinge joins cannot
-        pass through each other without intersecting on the way, and a step is
-        a small turn of that hinge. ``joined`` False leaves them out (a strategy
+        hinge keeps their faces a hair apart; their trimmed geometry
+        (:class:`~.solids.JoinedZones`) is checked at x1 instead (½ where it
+        intersects): two panels a hinge joins cannot pass through each other
+        without intersecting on the way, and a step is a small turn of that
+        hinge. ``joined`` False leaves them out (a strategy
         whose panels are not exactly rigid: their hinge holds them)."""
         s = self.solids
         self.blocking = []
@@ -322,7 +358,7 @@ class ContactModel:
         ipctk = _ipctk()
         fraction = 1.0
         for a, b in pairs:
-            mesh, ids, _ = self._pair_mesh(int(a), int(b), False)
+            mesh, ids, _ = self._pair_mesh(int(a), int(b))
             t = ipctk.compute_collision_free_stepsize(
                 mesh, np.asfortranarray(x0[ids]), np.asfortranarray(x1[ids]),
                 narrow_phase_ccd=self._ccd)
@@ -333,11 +369,11 @@ class ContactModel:
             fraction = min(fraction, self.obstacles.free_fraction(x0, x1))
         if not joined:
             return fraction
-        pairs, shrunk = self._joined_near(x1, 0.0)
-        for a, b in pairs:
-            mesh, ids, _ = self._pair_mesh(int(a), int(b), True)
-            if ipctk.has_intersections(mesh, np.asfortranarray(shrunk[ids])):
-                self.blocking.append((int(a), int(b)))
+        which, y = self._joined_near(x1, 0.0)
+        for k in which:
+            mesh, _, _ = self._zone_mesh(int(k))
+            if ipctk.has_intersections(mesh, np.asfortranarray(y[self.zones.rows(int(k))])):
+                self.blocking.append(tuple(int(p) for p in self.zones.pairs[k]))
                 return min(fraction, 0.5)
         return fraction
 
@@ -347,7 +383,7 @@ class ContactModel:
         ipctk = _ipctk()
         found = []
         for a, b in self.candidates(x, 0.0):
-            mesh, ids, _ = self._pair_mesh(int(a), int(b), False)
+            mesh, ids, _ = self._pair_mesh(int(a), int(b))
             if ipctk.has_intersections(mesh, np.asfortranarray(x[ids])):
                 found.append((a, b))
         return np.array(found, dtype=np.int64).reshape(-1, 2)
@@ -375,13 +411,3 @@ class ContactModel:
         s = self.solids
         return -np.add.reduceat(gradient[s.vertices], s.ptr[:-1]) if s.n_panels \
             else np.zeros((0, 3))
-
-
-def _shrink_map(n_a: int, n_b: int) -> np.ndarray:
-    """(3n, 3n) ∂(shrunk dofs)/∂(dofs) of a joined pair (n = n_a + n_b vertices,
-    vertex-major): per panel (1 − s) I + (s / n_p) 1 1ᵀ, s = ``JOINED_SHARE``."""
-    blocks = [(1.0 - JOINED_SHARE) * np.eye(n) + (JOINED_SHARE / n) * np.ones((n, n))
-              for n in (n_a, n_b)]
-    vertex_map = np.block([[blocks[0], np.zeros((n_a, n_b))],
-                           [np.zeros((n_b, n_a)), blocks[1]]])
-    return np.kron(vertex_map, np.eye(3))

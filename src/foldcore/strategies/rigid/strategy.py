@@ -152,9 +152,7 @@ class Rigid(Strategy):
 
     def _coarse_twin(self):
         """The mesh's coarse twin (:class:`.twin.Twin`), built once; None where there
-        is none, and with contact (the twin's panels would fold without it)."""
-        if self.model.contact is not None:
-            return None
+        is none."""
         if self._twin is None:
             from .twin import Twin, twin_mesh
 

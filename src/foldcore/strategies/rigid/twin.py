@@ -75,6 +75,8 @@ class Twin:
     def __init__(self, model, mesh, options):
         self.mesh = mesh
         self.model = twin_model(model, mesh)
+        if model.contact is not None:  # the same panels, kept apart as the mesh's are
+            self.model.contact = model.contact.twin(mesh, model.pattern)
         self.progress = Progress()
         self.engine = RigidBodySolver(self.model, self.progress, options)
         self.model.x = self.engine.x
@@ -86,8 +88,14 @@ class Twin:
         self.model.mirror_targets(model)
 
     def hand_over(self, engine) -> None:
-        """Put ``engine`` (the fine mesh's) at the twin's state (:func:`hand_over`)."""
+        """Put ``engine`` (the fine mesh's) at the twin's state (:func:`hand_over`); its
+        contact goes on from the twin's (κ, the pairs that cut the last step)."""
         hand_over(self.engine, engine)
+        contact = engine.model.contact
+        if contact is not None and self.model.contact is not None:
+            panels = np.empty(len(self.mesh.panel_of_face), dtype=np.int64)
+            panels[self.mesh.panel_of_face] = engine.model.mesh.panel_of_face
+            contact.take_over(self.model.contact, panels)
 
 
 def hand_over(source, target) -> None:
