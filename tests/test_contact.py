@@ -273,3 +273,61 @@ def test_contact_refuses_faces_split_into_cells(tmp_path):
     write_fold(path, pattern, thickness=H)
     assert main(["simulate", str(path), "--contact", "on", "--elastic-cells", "1"]) == 2
     assert main(["simulate", str(path), "--elastic-cells", "1"]) == 0
+
+
+def test_joined_panels_are_trimmed_of_their_hinge_zone():
+    """Contact sees two joined panels without the band along their crease that their
+    hinge decides (one hinge width deep, at most a quarter of the panel across) and
+    with their faces JOINED_SHARE × H closer: the letter fold's middle panel loses
+    W = πH/2 next to crease 1, its 6 mm neighbour a quarter of its 5.2 mm."""
+    from foldcore.contact.barrier import HINGE_ZONE
+    from foldcore.contact.solids import JoinedZones
+
+    pattern = letter_pattern()
+    mesh = thicken(pattern, H)
+    solids = PanelSolids(mesh, pattern)
+    width = mesh.hinge_width[solids.joined_crease]
+    zones = JoinedZones(solids, mesh, pattern, HINGE_ZONE * width, JOINED_SHARE)
+    assert np.allclose(zones.matrix.sum(axis=1), 1.0)  # convex combinations
+    (k,) = np.flatnonzero((zones.pairs == [0, 1]).all(axis=1))
+    ids, _ = zones.pair(k)
+    rest, trimmed = mesh.rest_positions[ids], zones.rest[zones.rows(k)]
+    n = len(ids) // 2  # panel 0 (x ≤ 5.2 mm), then panel 1 (x ≥ 6.8 mm)
+    side_0, side_1 = rest[:n, 0].max(), rest[n:, 0].min()
+    assert trimmed[:n, 0].max() == pytest.approx(side_0 - min(width[k], 0.25 * side_0))
+    assert trimmed[n:, 0].min() == pytest.approx(side_1 + width[k])
+    assert np.abs(trimmed[:, 2]).max() == pytest.approx(0.5 * H * (1 - JOINED_SHARE))
+
+
+def test_the_chain_and_the_box_keep_joined_panels_apart_beyond_their_hinge_zones():
+    """Joined panels are checked at every angle: at the end of the chain's push and of
+    the box's fold no two joined panels' trimmed solids intersect (what overlap
+    they have is inside their hinge zones), and the box's diagonal creases fold
+    on past the −150° at which checking them only from 150° on stopped them."""
+    import ipctk
+    from foldcore import scenes
+    from foldcore.contact.barrier import ContactModel
+
+    for name in ("chain", "box"):
+        run = scenes.run(name, quick=True, contact=True)
+        contact = ContactModel(run.mesh, run.pattern, 1.0)
+        y = contact.zones.positions(run.result.positions)
+        for k in range(len(contact.zones.pairs)):
+            mesh, _, _ = contact._zone_mesh(k)
+            assert not ipctk.has_intersections(mesh, np.asfortranarray(y[contact.zones.rows(k)]))
+        if name == "box":
+            for row in run.quantities["runs"]:  # H = 1 and 4 mm
+                assert row["fold_angles_deg"]["diagonal"]["achieved_mean_deg"] < -160.0
+
+
+def test_under_the_defaults_a_contact_that_never_engages_changes_nothing():
+    """``hybrid``'s rigid phase starts on the coarse twin, which keeps contact on its
+    own panels (the same prisms): where nothing touches, the run takes the same
+    steps to bit-identical positions (without contact on the twin, every step
+    would be the fine mesh's, another path)."""
+    pattern = patterns.miura_one_crease(6, 6, tilt=45.0)
+    mesh = thicken(pattern, H)
+    runs = [Simulation(mesh, pattern, contact=c).run(tolerance=1e-8) for c in (False, True)]
+    assert runs[0].iterations == runs[1].iterations
+    assert np.array_equal(runs[0].positions, runs[1].positions)
+    assert runs[1].contact["active_pairs"] == []
