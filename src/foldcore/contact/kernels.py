@@ -60,16 +60,6 @@ def _frame(x, vertices, start, stop):
     return (nx / length, ny / length, nz / length), (cx, cy, cz)
 
 
-@njit(cache=True)
-def normals(x, vertices, ptr, normal, centre):
-    """Each panel's unit normal (Newell's, of its top loop) and vertex centroid at
-    positions x (N, 3) into normal, centre (n_panels, 3)."""
-    for p in range(len(ptr) - 1):
-        n, c = _frame(x, vertices, ptr[p], ptr[p + 1])
-        for k in range(3):
-            normal[p, k], centre[p, k] = n[k], c[k]
-
-
 @njit(cache=True, inline="always")
 def _span(y, vertices, start, stop, ux, uy, uz):
     """(lo, hi) of the vertices ``vertices[start:stop]`` at y projected on (ux, uy, uz)."""
@@ -197,7 +187,6 @@ def compile_all() -> None:
     vertices, ptr = np.arange(16, dtype=np.int64), np.array([0, 8, 16], dtype=np.int64)
     lo, hi = np.empty((2, 3)), np.empty((2, 3))
     boxes(x, vertices, ptr, lo, hi)
-    normals(x, vertices, ptr, np.empty((2, 3)), np.empty((2, 3)))
     pairs = boxes_near(lo, hi, 1.0, np.zeros(0, dtype=np.int64))
     gap_bounds(x, x, False, vertices, ptr, pairs, np.array([[1, 2]], dtype=np.int64),
                np.empty(len(pairs)))

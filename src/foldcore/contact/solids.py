@@ -57,7 +57,6 @@ class PanelSolids:
         sizes = np.array([len(i) for i in ids], dtype=np.int64)
         self.vertices = np.concatenate(ids).astype(np.int64) if ids else np.zeros(0, np.int64)
         self.ptr = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
-        self.panel_of_vertex = np.repeat(np.arange(self.n_panels), sizes)
         self.triangles = self._triangles(mesh, ids)
         self.joined = self._joined(mesh, pattern)
 
@@ -97,13 +96,6 @@ class PanelSolids:
         lo, hi = np.empty((self.n_panels, 3)), np.empty((self.n_panels, 3))
         kernels.boxes(_positions(x), self.vertices, self.ptr, lo, hi)
         return lo, hi
-
-    def normals(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(normal, mid-plane point), each (n_panels, 3): each panel's unit normal
-        (Newell's, of its top loop) and the centroid of its vertices."""
-        normal, centre = np.empty((self.n_panels, 3)), np.empty((self.n_panels, 3))
-        kernels.normals(_positions(x), self.vertices, self.ptr, normal, centre)
-        return normal, centre
 
     def pairs_near(self, lo, hi, margin: float) -> np.ndarray:
         """(K, 2) panel pairs (a < b, sorted), not joined, whose boxes (lo, hi), each
