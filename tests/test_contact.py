@@ -244,7 +244,7 @@ def test_command_line_contact(tmp_path):
     path.write_text(json.dumps(LETTER))
     cli = [sys.executable, "-m", "foldcore", "simulate", str(path), "--thickness", "1",
            "--contact", "on"]
-    refused = subprocess.run(cli + ["--solver", "lbfgs"], capture_output=True, text=True)
+    refused = subprocess.run(cli + ["--solver", "anderson"], capture_output=True, text=True)
     assert refused.returncode == 2 and "Traceback" not in refused.stderr
     assert "--solver" in refused.stderr or "solver" in refused.stderr
     done = subprocess.run(cli + ["--solver", "rigid", "--report", str(tmp_path / "r.json"),
@@ -331,3 +331,33 @@ def test_under_the_defaults_a_contact_that_never_engages_changes_nothing():
     assert runs[0].iterations == runs[1].iterations
     assert np.array_equal(runs[0].positions, runs[1].positions)
     assert runs[1].contact["active_pairs"] == []
+
+
+def test_contact_is_on_by_default_for_a_thick_sheet_and_off_where_it_cannot_be():
+    """``contact="auto"`` (the default): the letter fold's outer panels stop on each
+    other; ``"off"`` lets them through; where a run cannot keep panels apart the
+    default is off and ``model.contact_off`` says why."""
+    pattern = letter_pattern()
+    mesh = thicken(pattern, H)
+    for contact, apart in (("auto", True), ("off", False)):
+        sim = Simulation(mesh, pattern, solver="rigid", contact=contact)
+        sim.set_fold_angles({0: 180.0, 1: 180.0})
+        shares = overlap_shares(mesh, sim.run(tolerance=1e-8, max_iterations=2_000).positions)
+        assert (max(shares.values(), default=0.0) <= OVERLAP_SHARE) is apart, shares
+    assert Simulation(mesh, pattern).model.contact_off is None
+    off = {"paper": Simulation(mesh, pattern, solver="paper").model,
+           "arc": Simulation(thicken(pattern, H, hinge="arc"), pattern).model}
+    assert off["paper"].contact is None and "'paper'" in off["paper"].contact_off
+    assert off["arc"].contact is None and "arc" in off["arc"].contact_off
+
+
+def test_lbfgs_keeps_panels_apart_and_changes_nothing_where_they_do_not_meet():
+    mesh, _, result = fold_letter(True, solver="lbfgs")
+    shares = overlap_shares(mesh, result.positions)
+    assert not shares or max(shares.values()) <= OVERLAP_SHARE, shares
+    pattern = patterns.miura_one_crease(4, 4, tilt=30.0)
+    mesh = thicken(pattern, H)
+    runs = [Simulation(mesh, pattern, solver="lbfgs", contact=c).run(tolerance=1e-8)
+            for c in ("off", "on")]
+    assert runs[0].iterations == runs[1].iterations
+    assert np.array_equal(runs[0].positions, runs[1].positions)

@@ -250,8 +250,8 @@ def test_a_converged_binding_fold_is_within_the_tolerance_of_its_equilibrium():
     angles = patterns.miura_fold_angles(n, n, gamma, 90.0)
     pattern = patterns.miura(n, n, a=A, b=A, gamma=gamma).replace(fold_angles=angles)
     mesh = thicken(pattern, 0.01 * A)
-    loose = Simulation(mesh, pattern).run(tolerance=1e-8, max_iterations=3000)
-    sim = Simulation(mesh, pattern)
+    loose = Simulation(mesh, pattern, contact="off").run(tolerance=1e-8, max_iterations=3000)
+    sim = Simulation(mesh, pattern, contact="off")  # the binding model's own equilibrium
     tight = sim.run(tolerance=1e-9, max_iterations=3000)
     assert loose.converged and tight.converged
     assert tight.energy[-1] <= 0.071381  # not newton's early stop at 0.0714274 mm⁵
@@ -274,9 +274,10 @@ def test_extrapolating_a_binding_tail_keeps_the_equilibrium():
     angles = patterns.miura_fold_angles(n, n, gamma, 90.0)
     pattern = patterns.miura(n, n, a=A, b=A, gamma=gamma).replace(fold_angles=angles)
     mesh = thicken(pattern, 0.01 * A)
-    jumped = Simulation(mesh, pattern).run(tolerance=1e-9, max_iterations=3000)
+    jumped = Simulation(mesh, pattern, contact="off").run(tolerance=1e-9, max_iterations=3000)
     never = HybridOptions(rigid=RigidOptions(extrapolate_cos=2.0))  # no two steps aligned
-    plain = Simulation(mesh, pattern, options=never).run(tolerance=1e-9, max_iterations=3000)
+    plain = Simulation(mesh, pattern, options=never, contact="off").run(tolerance=1e-9,
+                                                                       max_iterations=3000)
     assert jumped.converged and plain.converged
     assert jumped.iterations < plain.iterations
     assert jumped.energy[-1] == pytest.approx(plain.energy[-1], rel=1e-12)
@@ -300,7 +301,7 @@ def test_newton_at_its_resolution_ends_stalled_not_at_the_budget():
     from foldcore.strategies import newton
 
     pattern, mesh = flat_miura6()
-    sim = Simulation(mesh, pattern)
+    sim = Simulation(mesh, pattern, contact="off")  # panels would meet: the binding model alone
     result = sim.run(tolerance=1e-13, max_iterations=3000)
     assert result.reason == "stalled" and not result.converged
     assert result.iterations < 1000

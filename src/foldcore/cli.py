@@ -261,11 +261,12 @@ def _add_solving(sim) -> None:
                           "least DEG degrees (0 … 180) on their assigned side, then release "
                           "them (branch selection; 0 turns it off; default "
                           f"{BRANCH_FLOOR_DEG:g})")
-    sim.add_argument("--contact", choices=CONTACT_CHOICES, default="off",
-                     help="on: panels no crease joins never pass through each other (IPC "
+    sim.add_argument("--contact", choices=CONTACT_CHOICES, default="auto",
+                     help="panels no crease joins never pass through each other (IPC "
                           "barrier and collision-checked steps; solvers hybrid, rigid, "
-                          "newton; needs the ipctk package); default off, on with "
-                          "--obstacle or --ground")
+                          "newton; needs the ipctk package): auto (default) wherever the "
+                          "run can (a thick sheet of rigid panels), on (refused where it "
+                          "cannot be), off; on with --obstacle or --ground")
     sim.add_argument("--obstacle", action="append", default=[], metavar="MESH",
                      help="a fixed obstacle the sheet touches but never passes: a mesh file "
                           "(STL, OBJ, PLY, ... read by meshio) in mm in the pattern's frame "
@@ -343,8 +344,9 @@ def _add_scene(sub) -> None:
     scn.add_argument("--quick", action="store_true",
                      help="lower iteration budgets (tests); same geometry")
     scn.add_argument("--contact", choices=CONTACT_CHOICES,
-                     help="on: panels never pass through each other (scenes of rigid "
-                          "panels); default: the scene's own (on for gripper, else off)")
+                     help="panels never pass through each other: auto (wherever the scene's "
+                          "runs can: thick rigid panels), on, off; default: the scene's "
+                          "own (on for gripper, else auto)")
 
 
 def run_scene(args) -> int:
@@ -357,12 +359,14 @@ def run_scene(args) -> int:
         raise FoldcoreError(f"{args.out or '--out ' + repr('')}: output folder does not exist")
     check_destinations({"--out": Path(args.out) / f"{args.name}.fold"})  # writable, before
     run = scenes.run(args.name, quick=args.quick, solver=args.solver,
-                     contact=None if args.contact is None else args.contact == "on")
+                     contact=args.contact)
     for path in scenes.write(run, args.out, png=args.render):
         print(path)
     if not run.result.converged:
-        print(f"foldcore: warning: {args.name}: the last run stopped at its iteration "
-              "budget without converging", file=sys.stderr)
+        how = ("stopped at its iteration budget" if run.result.reason == "budget"
+               else f"ended {run.result.reason}")
+        print(f"foldcore: warning: {args.name}: the last run {how} without converging",
+              file=sys.stderr)
     return 0
 
 

@@ -149,6 +149,11 @@ def fold(path, *, hinges=None, reading=None, thickening=None, solving=None, outp
             result, interrupted = sim.result(False, "interrupted"), True
     summary, said = run_summary(result, loaded.pattern, job.source, s.fold_percent,
                                 model="elastic" if mesh.elastic else "rigid")
+    from .simulation import NO_IPCTK  # imported with the Simulation above
+
+    if sim.model.contact_off == NO_IPCTK:
+        said = [f"{job.source}: contact off: {sim.model.contact_off}; panels may pass "
+                f"through each other", *said]
     for text in said:
         warnings.warn(text, RunWarning, stacklevel=3)
     settings = run_settings(job, thickness, mesh, sim)
@@ -262,7 +267,7 @@ def _simulation(job: Job, loaded, thickness: float):
                    elastic="facets" if cells else None, cell_size=cells)
     sim = Simulation(mesh, loaded.pattern, solver=s.solver, actuation=s.actuation,
                      branch_floor_deg=s.branch_floor, options=s.strategy_options,
-                     contact=s.contact_on, obstacles=_obstacles(s, loaded.pattern))
+                     contact=s.contact_asked, obstacles=_obstacles(s, loaded.pattern))
     return mesh, sim
 
 
@@ -290,7 +295,8 @@ def run_settings(job: Job, thickness: float, mesh, sim) -> dict:
             "subdivisions": t.subdivisions, "thickness_mm": thickness,
             "hinge": sorted(set(mesh.hinge_model) - {""}), "actuation": s.actuation,
             "branch_floor_deg": s.branch_floor, "elastic_cells_mm": t.elastic_cells,
-            "contact": "on" if s.contact_on else "off",
+            "contact": "off" if sim.model.contact is None else "on",
+            **({"contact_off": sim.model.contact_off} if sim.model.contact is None else {}),
             "obstacles": list(s.obstacles), "ground_mm": s.ground,
             "backend": sim.system.backend}
 

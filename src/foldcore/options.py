@@ -20,7 +20,7 @@ from .limits import MAX_ITERATIONS, SUBDIVISIONS, THICK_BUDGET, TOLERANCE
 from .strategies import DEFAULT_SOLVER
 
 MAX_FRAMES = 10_000
-CONTACT_CHOICES = ("off", "on")
+CONTACT_CHOICES = ("auto", "on", "off")
 MAX_FPS = 100.0
 
 
@@ -121,11 +121,14 @@ class Solving:
         fold leaves the flat sheet (0: off).
     strategy_options : dataclass, optional
         The strategy's own options (its ``Options`` class).
-    contact : {"off", "on"}
-        ``"on"``: panels that no crease joins never pass through each other
-        (:mod:`foldcore.contact`; strategies with ``supports_contact``: ``hybrid``,
-        ``rigid``, ``newton``).
-        Obstacles turn it on.
+    contact : {"auto", "on", "off"}
+        Whether panels no crease joins may pass through each other
+        (:mod:`foldcore.contact`). ``"auto"`` (default): kept apart wherever the
+        run can (a thick sheet of rigid panels without cuts, ``axis`` or
+        ``slack`` hinges, a strategy with ``supports_contact``: ``hybrid``,
+        ``rigid``, ``newton``, ``lbfgs``, and ipctk installed), else off;
+        ``"on"``: kept apart, refused where it cannot be; ``"off"``: not
+        checked. Obstacles turn it on.
     obstacles : tuple of str
         Mesh files (STL, OBJ, PLY, … in mm, the pattern's frame: the flat sheet's
         mid-surface is z = 0) of fixed obstacles the sheet touches but never passes.
@@ -143,7 +146,7 @@ class Solving:
     actuation: str = DEFAULT_ACTUATION
     branch_floor: float = BRANCH_FLOOR_DEG
     strategy_options: object = None
-    contact: str = "off"
+    contact: str = "auto"
     obstacles: tuple = ()
     ground: float | None = None
 
@@ -154,9 +157,10 @@ class Solving:
         return default if self.max_iterations is None else self.max_iterations
 
     @property
-    def contact_on(self) -> bool:
-        """Whether the run keeps panels apart: asked for, or obstacles to keep off."""
-        return self.contact == "on" or bool(self.obstacles) or self.ground is not None
+    def contact_asked(self) -> str:
+        """The run's contact setting: ``"on"`` where obstacles need it, else
+        ``contact``."""
+        return "on" if self.obstacles or self.ground is not None else self.contact
 
     def __post_init__(self):
         _within(self.fold_percent, -100.0, 100.0, "solving.fold_percent")

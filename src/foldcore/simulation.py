@@ -75,6 +75,11 @@ class Simulation:
     convergence : type, optional
         The convergence test (a :class:`foldcore.convergence.ConvergenceTest`
         subclass), built with the model and the run's progress.
+    contact : {"auto", "on", "off"}, bool or ContactSettings
+        Panels no crease joins never pass through each other (:mod:`foldcore.contact`):
+        ``"auto"`` (default) wherever the run can (``model.contact_off`` says why
+        not), ``"on"`` (True, settings) or an error, ``"off"`` (False) unchecked.
+    obstacles : sequence of foldcore.contact.Obstacle (fixed; they need contact)
     """
 
     def __init__(self, mesh, pattern, solver: str = DEFAULT_SOLVER, backend: str = "auto",
@@ -82,7 +87,7 @@ class Simulation:
                  threads: int | None = None, strain_limits=None,
                  actuation: str = DEFAULT_ACTUATION,
                  branch_floor_deg: float = BRANCH_FLOOR_DEG, options=None,
-                 convergence=ConvergenceTest, contact=None, obstacles=()):
+                 convergence=ConvergenceTest, contact="auto", obstacles=()):
         start = time.perf_counter()
         try:
             strategy = strategies.get(solver)
@@ -431,22 +436,32 @@ class Simulation:
 
 
 def contact_model(model, strategy, contact, obstacles=()):
-    """The :class:`foldcore.contact.ContactModel` ``contact`` asks for (None, False:
-    none; True: default settings; a :class:`foldcore.contact.ContactSettings`), with
-    ``obstacles`` (:class:`foldcore.contact.Obstacle`; they turn contact on where it
-    is None). SimulationError where an obstacle touches a panel at the start."""
-    obstacles = list(obstacles or ())
-    if obstacles and contact is False:
-        raise SimulationError("obstacles need contact: drop contact=False")
-    if contact is None and obstacles:
-        contact = True
-    if contact is None or contact is False:
-        return None
-    from .contact import ContactModel, ContactSettings
+    """The :class:`foldcore.contact.ContactModel` ``contact`` asks for, with
+    ``obstacles`` (:class:`foldcore.contact.Obstacle`, which need contact).
 
-    settings = ContactSettings() if contact is True else contact
+    ``contact``: None or ``"auto"`` (the default): on where the run can keep panels
+    apart, else off with the reason :func:`contact_unfit` gives kept in
+    ``model.contact_off``; True, ``"on"`` or a
+    :class:`foldcore.contact.ContactSettings`: on, and a SimulationError where it
+    cannot be; False, ``"off"``: off. SimulationError where an obstacle touches a
+    panel at the start."""
+    obstacles = list(obstacles or ())
+    if contact in (False, "off"):
+        if obstacles:
+            raise SimulationError("obstacles need contact: drop contact=False")
+        model.contact_off = "turned off (contact='off')"
+        return None
+    auto = contact is None or contact == "auto"
+    if auto and not obstacles:
+        model.contact_off = contact_unfit(model, strategy)
+        if model.contact_off:
+            return None
+        contact = True
+    from .contact import ContactSettings
+
+    settings = ContactSettings() if contact in (True, "on", None, "auto") else contact
     if not isinstance(settings, ContactSettings):
-        raise SimulationError(f"contact must be True, False or a "
+        raise SimulationError(f"contact must be 'auto', True, False or a "
                               f"foldcore.contact.ContactSettings, got {contact!r}")
     if not strategy.supports_contact:
         supported = [name for name in strategies.available()
@@ -458,6 +473,8 @@ def contact_model(model, strategy, contact, obstacles=()):
     if model.mesh.panel_group != "rigid_panel" or _faces_split(model.mesh):
         raise SimulationError("contact needs one rigid panel per face (this mesh's faces "
                               "are elastic cells: drop the elastic cells or contact)")
+    from .contact import ContactModel
+
     try:
         built = ContactModel(model.mesh, model.pattern, model.system.reference_weight,
                              settings, obstacles)
@@ -473,6 +490,33 @@ def contact_model(model, strategy, contact, obstacles=()):
                               f"move it clear of the sheet (its faces are at ±H/2 = "
                               f"±{0.5 * model.mesh.thickness:g} mm)")
     return built
+
+
+#: Why the default contact is off where ipctk is missing (the command line says it).
+NO_IPCTK = "the ipctk package is not installed (pip install 'foldcore[contact]')"
+
+
+def contact_unfit(model, strategy) -> str | None:
+    """Why the default contact is off for this run (None: it is on): a thin sheet, a
+    strategy whose steps are not checked, faces split into elastic cells, cuts,
+    hinges whose axis drifts off the crease, or no ipctk."""
+    if not model.mesh.thickness > 0:
+        return "a sheet without thickness"
+    if not strategy.supports_contact:
+        return f"solver {strategy.name!r} does not keep panels apart"
+    if model.mesh.panel_group != "rigid_panel" or _faces_split(model.mesh):
+        return "faces split into elastic cells"
+    if len(model.pattern.copied_from):
+        return "the sheet has cuts: the panels either side of a slit touch from the start"
+    drifting = sorted(set(model.mesh.hinge_model) & {"arc", "eq8"})
+    if drifting:
+        return (f"{' and '.join(drifting)} hinges turn their panels about an axis off the "
+                f"crease, past what contact leaves to a hinge (contact='on' checks them)")
+    import importlib.util
+
+    if importlib.util.find_spec("ipctk") is None:
+        return NO_IPCTK
+    return None
 
 
 #: A position target "misses" beyond this share of the pattern's size (Result).

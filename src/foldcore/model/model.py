@@ -92,6 +92,7 @@ class Model:
         self.length_scale = float(np.ptp(pattern.vertices, axis=0).max())
         self.timings = {"setup": 0.0, "projection": 0.0, "solve": 0.0}
         self.contact = None  # a foldcore.contact.ContactModel where panels must not cross
+        self.contact_off = None  # why contact is off (None: on, or not decided yet)
         self._subscribers = []
         self._scratch = False  # True while a probe projects (no stop changes)
         self._last_fold_angles = None  # (positions, angles) of the last fold_angles call

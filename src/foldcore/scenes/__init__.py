@@ -5,9 +5,10 @@ the paper reports, beside the closed forms of :mod:`foldcore.kinematics` where t
 >>> run = scenes.run("d4v", quick=True)          # doctest: +SKIP
 >>> run.quantities["flat"]["fold_angles_deg"]     # doctest: +SKIP
 
-Every scene module defines ``run(quick=False, solver=None, contact=False) ->
+Every scene module defines ``run(quick=False, solver=None, contact="auto") ->
 SceneRun`` and ``headline(quantities) -> str`` (one line for the demo), and may
-set ``CONTACT = True`` where contact is what it shows;
+set ``CONTACT = True`` where contact is what it shows (on even where "auto"
+would not be);
 ``quick`` lowers iteration budgets for tests, never the geometry. Which
 scenes exist is known without importing them (``NAMES``), so the CLI's
 ``--help`` and this package stay light.
@@ -67,7 +68,7 @@ class SceneRun:
 
 
 def run(name: str, quick: bool = False, solver: str | None = None,
-        contact: bool | None = None) -> SceneRun:
+        contact: str | bool | None = None) -> SceneRun:
     """Run scene ``name`` (see ``NAMES``).
 
     Parameters
@@ -76,14 +77,14 @@ def run(name: str, quick: bool = False, solver: str | None = None,
         Lower iteration budgets (tests); the geometry is unchanged.
     solver : str, optional
         Strategy (``foldcore.strategies.SOLVERS``); default: the scene's own.
-    contact : bool, optional
+    contact : {"auto", "on", "off"} or bool, optional
         Keep panels from passing through each other (:mod:`foldcore.contact`;
-        scenes of rigid panels, strategies that take it); None: the scene's own
-        choice (its ``CONTACT``, off unless the scene is about contact).
+        ``Simulation``'s ``contact``); None: the scene's own choice (its
+        ``CONTACT``, else ``"auto"``: on wherever its runs can).
     """
     module = _module(name)
     if contact is None:
-        contact = getattr(module, "CONTACT", False)
+        contact = getattr(module, "CONTACT", "auto")
     return module.run(quick=quick, solver=solver, contact=contact)
 
 

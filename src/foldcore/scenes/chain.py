@@ -72,7 +72,7 @@ HINGE = "arc"  # the paper's strained joint; why not the default axis hinge: mod
 
 
 def run(quick: bool = False, solver: str | None = None,
-        contact: bool = False) -> SceneRun:
+        contact="auto") -> SceneRun:
     """Deploy the chain, then push one end across it (see module docstring)."""
     solver = solver or "rigid"
     budget = 400 if solver == "rigid" else (5_000 if quick else 40_000)
@@ -97,7 +97,7 @@ def run(quick: bool = False, solver: str | None = None,
     quantities = {"deployed": _deployed_quantities(deployed, pattern, expected, kinds),
                   "before": _lengths(rows[0]), "after": _lengths(rows[-1]),
                   "rigid_fold_lengths_mm": _rigid_fold_lengths(), "pushes": rows}
-    settings = {"solver": solver, "contact": contact, "tolerance": TOLERANCE,
+    settings = {"solver": solver, "contact": sim.model.contact is not None, "tolerance": TOLERANCE,
                 "max_iterations": budget,
                 "thickness_mm": THICKNESS, "hinge_width_mm": round(WIDTH, 4),
                 "subdivisions": SUBDIVISIONS, "n": N, "m": M, "a_mm": A, "b_mm": B,

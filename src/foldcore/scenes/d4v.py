@@ -54,9 +54,9 @@ TOLERANCE = 1e-10  # relative step at which a state counts as reached
 
 
 def run(quick: bool = False, solver: str | None = None,
-        contact: bool = False) -> SceneRun:
+        contact="auto") -> SceneRun:
     """Fold the vertex to its intermediate and flat states (see module docstring)."""
-    budget = 400 if quick else 2_000
+    budget = 1_000 if quick else 2_000
     pattern = degree4_vertex(mode="A", rho1=INTERMEDIATE)
     mesh = thicken(pattern, THICKNESS, subdivisions=SUBDIVISIONS, hinge=HINGE)
     sim = Simulation(mesh, pattern, contact=contact, **({"solver": solver} if solver else {}))
@@ -78,8 +78,8 @@ def run(quick: bool = False, solver: str | None = None,
                 degree4_deg(alpha, beta, min(abs(angles[0]), 180.0), "A")),
             "iterations": int(result.iterations - before), "converged": bool(result.converged)}
     quantities["flat"].update(stack(mesh, pattern, result.positions))
-    settings = {"solver": sim.solver, "contact": contact, "hinge": HINGE, "tolerance": TOLERANCE,
-                "max_iterations": budget, "thickness_mm": THICKNESS,
+    settings = {"solver": sim.solver, "contact": sim.model.contact is not None, "hinge": HINGE,
+                "tolerance": TOLERANCE, "max_iterations": budget, "thickness_mm": THICKNESS,
                 "subdivisions": SUBDIVISIONS}
     return SceneRun("d4v", sim.pattern, mesh, THICKNESS, result, quantities, settings)
 

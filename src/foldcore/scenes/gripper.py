@@ -81,7 +81,7 @@ def run(quick: bool = False, solver: str | None = None,
         contact: bool | None = None) -> SceneRun:
     """Deploy the gripper, squeeze it shut, then squeeze it on a ball (module docstring)."""
     solver = solver or "rigid"
-    contact = CONTACT if contact is None else bool(contact)
+    contact = CONTACT if contact in (None, "auto") else contact not in (False, "off")
     budget = 400 if solver == "rigid" else (5_000 if quick else 40_000)
     pattern = gripper(HALF_WIDTH, HALF_LENGTH, OFFSET, width=WIDTH)
     mesh = thicken(pattern, THICKNESS, subdivisions=SUBDIVISIONS)

@@ -59,7 +59,7 @@ def hinge_pose(points: np.ndarray, psi_deg: float, model: str = DEFAULT_HINGE) -
 
 
 def run(quick: bool = False, solver: str | None = None,
-        contact: bool = False) -> SceneRun:
+        contact="auto") -> SceneRun:
     """Pull the bar past its groove's limit (see module docstring)."""
     solver = solver or "lbfgs"
     budget = 10_000 if quick else 40_000
@@ -90,7 +90,7 @@ def run(quick: bool = False, solver: str | None = None,
                      "iterations": int(result.iterations) - done,
                      "converged": bool(result.converged)})
         done = int(result.iterations)
-    settings = {"solver": solver, "contact": contact, "tolerance": TOLERANCE,
+    settings = {"solver": solver, "contact": sim.model.contact is not None, "tolerance": TOLERANCE,
                 "max_iterations": budget,
                 "thickness_mm": THICKNESS, "hinge_width_mm": WIDTH, "cells": CELLS}
     return SceneRun("groove-bar", pattern, mesh, THICKNESS, result, {"steps": rows}, settings)

@@ -43,7 +43,7 @@ DEGENERATE_RADIUS = 100.0  # fitted radius / span of the inner points beyond whi
 
 
 def run(quick: bool = False, solver: str | None = None,
-        contact: bool = False) -> SceneRun:
+        contact="auto") -> SceneRun:
     """Fold the hinge for every (hinge model, W, k) (module docstring); the last is the result."""
     solver = solver or "rigid"
     budget = (100 if quick else 400) if solver == "rigid" else (5_000 if quick else 60_000)
@@ -65,7 +65,7 @@ def run(quick: bool = False, solver: str | None = None,
             "iterations": int(result.iterations), "converged": bool(result.converged)})
         gallery.append((f"{model} W {width:g} k {k}: {achieved:.2f}°", pattern, mesh,
                         result.positions))
-    settings = {"solver": solver, "contact": contact, "tolerance": TOLERANCE,
+    settings = {"solver": solver, "contact": result.contact is not None, "tolerance": TOLERANCE,
                 "max_iterations": budget,
                 "thickness_mm": THICKNESS, "panel_mm": PANEL, "depth_mm": DEPTH}
     return SceneRun("hinge-study", pattern, mesh, THICKNESS, result, {"runs": rows}, settings,

@@ -39,7 +39,7 @@ TOLERANCE = 1e-10
 
 
 def run(quick: bool = False, solver: str | None = None,
-        contact: bool = False) -> SceneRun:
+        contact="auto") -> SceneRun:
     """Fold the sheet to tilt θ with every crease actuated (see module docstring)."""
     solver = solver or "rigid"
     budget = (100 if quick else 400) if solver == "rigid" else (2_000 if quick else 40_000)
@@ -59,7 +59,7 @@ def run(quick: bool = False, solver: str | None = None,
                               "achieved_mean_deg": round(float(achieved.mean()), 4),
                               "max_deviation_deg": round(float(np.abs(achieved - closed).max()), 4)}
     quantities["extent_mm"] = _extents(pattern, mesh, result.positions)
-    settings = {"solver": solver, "contact": contact, "tolerance": TOLERANCE,
+    settings = {"solver": solver, "contact": result.contact is not None, "tolerance": TOLERANCE,
                 "max_iterations": budget,
                 "thickness_mm": THICKNESS, "hinge_width_mm": WIDTH,
                 "subdivisions": SUBDIVISIONS, "n": N, "m": M, "a_mm": A, "b_mm": B,

@@ -37,7 +37,7 @@ TOLERANCE = 1e-10
 
 
 def run(quick: bool = False, solver: str | None = None,
-        contact: bool = False) -> SceneRun:
+        contact="auto") -> SceneRun:
     """Fold position 1 and position 2 from the flat sheet (see module docstring)."""
     solver = solver or "rigid"
     budget = (100 if quick else 400) if solver == "rigid" else (2_000 if quick else 40_000)
@@ -61,7 +61,7 @@ def run(quick: bool = False, solver: str | None = None,
                                                                      abs(major_angle))), 3),
             "table_1": TABLE_1[position],
             "iterations": int(result.iterations), "converged": bool(result.converged)}
-    settings = {"solver": solver, "contact": contact, "tolerance": TOLERANCE,
+    settings = {"solver": solver, "contact": result.contact is not None, "tolerance": TOLERANCE,
                 "max_iterations": budget,
                 "thickness_mm": THICKNESS, "hinge_width_mm": WIDTH,
                 "subdivisions": SUBDIVISIONS, "radius_mm": RADIUS}

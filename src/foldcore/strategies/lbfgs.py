@@ -3,7 +3,12 @@
 Liu, Bouaziz & Kavan 2017, "Quasi-Newton methods for real-time simulation of
 hyperelastic materials": the two-loop recursion with H₀ = K⁻¹ (one K solve
 per iteration) and an Armijo backtracking line search on E; when the search
-fails the plain step is taken and the history forgotten. Shared bookkeeping
+fails the plain step is taken and the history forgotten. With contact
+(``model.contact``) the barrier of panels no crease joins joins E and its
+gradient, and every step, the line search's first and the plain one, is
+shortened until the straight-line motion to it is collision-free
+(:mod:`.vertex_contact`; joined panels are their hinge's to hold, as in
+``newton``). Shared bookkeeping
 and the energy's gradient: :mod:`.accelerated`. Where it serves and where it
 does not: `docs/architecture.md#the-accelerated-maps`.
 """
@@ -15,6 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .accelerated import Accelerated
+from .vertex_contact import VertexContact
 
 
 @dataclass(frozen=True)
@@ -44,6 +50,11 @@ class Lbfgs(Accelerated):
 
     name = "lbfgs"
     Options = LbfgsOptions
+    supports_contact = True
+
+    def __init__(self, model, progress, options=None):
+        self.contact = VertexContact(model) if model.contact is not None else None
+        super().__init__(model, progress, options)
 
     def _forget(self) -> None:
         self._pairs = deque(maxlen=self.memory)
@@ -51,10 +62,33 @@ class Lbfgs(Accelerated):
 
     def _evaluate(self, x: np.ndarray) -> tuple[float, np.ndarray]:
         energy, rhs = self.model.local_step(x)
-        return energy, self.model.system.apply(x) - rhs  # ½∇E
+        grad = self.model.system.apply(x) - rhs  # ½∇E
+        if self.contact is not None:
+            touch = self.contact.state(x)
+            energy += touch.energy
+            grad = grad + self.contact.gradient(touch).reshape(-1, 3)
+        return energy, grad
+
+    def _stiffened(self) -> bool:
+        """IPC's adaptive κ at the current point (``ContactModel.stiffen``): True where
+        it changed (energies taken before are stale)."""
+        return self.contact is not None and \
+            self.contact.contact.stiffen(self.contact.state(self.x))
+
+    def _free_share(self, direction: np.ndarray) -> float:
+        """The share of the step x → x + direction whose straight-line motion brings no
+        two panels (or a panel and an obstacle) into contact (1 without contact)."""
+        if self.contact is None:
+            return 1.0
+        trial = self.x + direction
+        free = self.contact.collision_free(self.x, trial)
+        if free is trial:
+            return 1.0
+        return 0.0 if free is self.x else float(
+            np.abs(free - self.x).max() / max(np.abs(direction).max(), 1e-300))
 
     def _advance(self) -> tuple[float, float]:
-        if self._at is None or self._k_changed():
+        if self._at is None or self._k_changed() or self._stiffened():
             self._at = self._evaluate(self.x)
             self._k_changed()
             self._pairs.clear()
@@ -66,10 +100,11 @@ class Lbfgs(Accelerated):
             direction = self._direction(grad)
             slope = float(np.vdot(grad, direction))
         x_new, at_new = self._line_search(energy, slope, direction)
-        if x_new is None:  # no sufficient decrease: the plain step, unchecked
+        if x_new is None:  # no sufficient decrease: the plain step (its share free of contact)
             self.rejected += 1
             self._pairs.clear()
-            x_new = self.x + self._direction(grad)
+            plain = self._direction(grad)
+            x_new = self.x + self._free_share(plain) * plain
             at_new = self._evaluate(x_new)
         s, y = x_new - self.x, at_new[1] - grad
         if float(np.vdot(s, y)) > 1e-12 * float(np.vdot(s, s)) * self.model.system.reference_weight:
@@ -93,8 +128,11 @@ class Lbfgs(Accelerated):
         return r
 
     def _line_search(self, energy, slope, direction):
-        """Armijo backtracking from step 1; (x, (energy, ½∇E)) or (None, None)."""
-        step = 1.0
+        """Armijo backtracking from step 1 (or the share of it free of contact);
+        (x, (energy, ½∇E)) or (None, None)."""
+        step = self._free_share(direction)
+        if step == 0.0:
+            return None, None
         for _ in range(self.options.backtracks + 1):
             x = self.x + step * direction
             at = self._evaluate(x)

@@ -63,7 +63,7 @@ class Hybrid(Strategy):
 
     name = "hybrid"
     Options = HybridOptions
-    supports_contact = True  # both phases keep panels apart (rigid, newton)
+    supports_contact = True  # every phase keeps panels apart (rigid, newton, lbfgs)
 
     def __init__(self, model, progress, options=None):
         super().__init__(model, progress, options)
@@ -81,11 +81,11 @@ class Hybrid(Strategy):
 
     def _finishing(self) -> Strategy:
         """The strategy after (or instead of) the rigid phase: ``newton`` on a mesh whose
-        elastic faces are all in rings or that keeps panels apart (contact), else
-        ``lbfgs`` (from rest ``newton`` turns panels of bars and plates by small linear
-        steps)."""
+        elastic faces are all in rings, else ``lbfgs`` (from rest ``newton`` turns
+        panels of bars and plates by small linear steps); both keep panels apart
+        with contact."""
         o = self.options
-        if in_rings(self.model.mesh) or self.model.contact is not None:  # lbfgs lets panels cross
+        if in_rings(self.model.mesh):
             return Newton(self.model, self.progress, o.newton)
         return Lbfgs(self.model, self.progress, o.lbfgs)
 
