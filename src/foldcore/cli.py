@@ -264,9 +264,10 @@ def _add_solving(sim) -> None:
     sim.add_argument("--contact", choices=CONTACT_CHOICES, default="auto",
                      help="panels no crease joins never pass through each other (IPC "
                           "barrier and collision-checked steps; solvers hybrid, rigid, "
-                          "newton; needs the ipctk package): auto (default) wherever the "
-                          "run can (a thick sheet of rigid panels), on (refused where it "
-                          "cannot be), off; on with --obstacle or --ground")
+                          "newton, lbfgs; needs the ipctk package): auto (default) wherever "
+                          "the run can (thick rigid panels, no cuts, axis or slack hinges), "
+                          "on (refused where it cannot be), off; on with --obstacle or "
+                          "--ground")
     sim.add_argument("--obstacle", action="append", default=[], metavar="MESH",
                      help="a fixed obstacle the sheet touches but never passes: a mesh file "
                           "(STL, OBJ, PLY, ... read by meshio) in mm in the pattern's frame "
