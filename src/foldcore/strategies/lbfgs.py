@@ -54,6 +54,7 @@ class Lbfgs(Accelerated):
 
     def __init__(self, model, progress, options=None):
         self.contact = VertexContact(model) if model.contact is not None else None
+        self._touch = None  # (x, the contacts there) of the last point evaluated
         super().__init__(model, progress, options)
 
     def _forget(self) -> None:
@@ -65,15 +66,20 @@ class Lbfgs(Accelerated):
         grad = self.model.system.apply(x) - rhs  # ½∇E
         if self.contact is not None:
             touch = self.contact.state(x)
+            self._touch = (x, touch)
             energy += touch.energy
             grad = grad + self.contact.gradient(touch).reshape(-1, 3)
         return energy, grad
 
     def _stiffened(self) -> bool:
-        """IPC's adaptive κ at the current point (``ContactModel.stiffen``): True where
-        it changed (energies taken before are stale)."""
-        return self.contact is not None and \
-            self.contact.contact.stiffen(self.contact.state(self.x))
+        """IPC's adaptive κ at the current point (``ContactModel.stiffen``), on the
+        contacts its evaluation found (the accepted trial's): True where κ changed
+        (energies taken before are stale)."""
+        if self.contact is None:
+            return False
+        kept = self._touch is not None and self._touch[0] is self.x
+        touch = self._touch[1] if kept else self.contact.state(self.x)
+        return self.contact.contact.stiffen(touch)
 
     def _free_share(self, direction: np.ndarray) -> float:
         """The share of the step x → x + direction whose straight-line motion brings no
