@@ -36,8 +36,8 @@ def _evaluate(kind, size, p, nodes, rest, reference, hessian=False):
 def test_a_sliver_corner_meets_a_barrier_that_keeps_its_facet_from_collapsing():
     """A triangle whose corner closes below SLIVER of its rest angle: its energy is
     the corner springs' plus k (SLIVER / r − 1)² per sliver corner (r = α / α₀),
-    growing without bound as the corner closes, and its gradient is still the
-    energy's (central differences); above SLIVER nothing is added."""
+    growing without bound as the corner closes, and its gradient and Hessian are
+    still the energy's (central differences); above SLIVER nothing is added."""
     rest = np.array([[1.0, 1.0, np.pi - 2.0]])
     nodes = np.array([[0, 1, 2, 0]])
     k = 1.3
@@ -69,6 +69,15 @@ def test_a_sliver_corner_meets_a_barrier_that_keeps_its_facet_from_collapsing():
             fd[i] = (_evaluate(TRIANGLE, 3, plus, nodes, rest, np.zeros(1))[0]
                      - _evaluate(TRIANGLE, 3, minus, nodes, rest, np.zeros(1))[0]) / (2 * h)
         assert np.max(np.abs(gradient - fd)) <= 1e-5 * np.max(np.abs(fd))
+        _, _, hessian = _evaluate(TRIANGLE, 3, p, nodes, rest, np.zeros(1), True)
+        fd_h = np.zeros((9, 9))
+        for i in range(9):
+            plus, minus = p.copy(), p.copy()
+            plus.ravel()[i] += h
+            minus.ravel()[i] -= h
+            fd_h[:, i] = (_evaluate(TRIANGLE, 3, plus, nodes, rest, np.zeros(1))[1]
+                          - _evaluate(TRIANGLE, 3, minus, nodes, rest, np.zeros(1))[1]) / (2 * h)
+        assert np.max(np.abs(hessian - fd_h)) <= 1e-5 * np.max(np.abs(fd_h))
     assert energy > 1e3 * k  # closed to 1e-3 of its rest angle: the barrier dominates
 
 

@@ -40,7 +40,6 @@ from elements.cache import choose_cache_dir
 
 choose_cache_dir(Path(__file__))  # before this module's cache=True kernels (read-only installs)
 
-STEP = 1e-8  # forward-difference step of the Hessians × the element's size (√ε: ~1e-8 relative)
 #: A triangle lower than this (normalised units) has collapsed: Origami Simulator's
 #: tolerance, below which it disables a crease; the smallest element size a step scales to.
 COLLAPSED = 1e-6
@@ -105,6 +104,87 @@ def fold_angle_gradient(p, g):
 
 
 @njit(cache=True)
+def _symmetrise(h, n):
+    """``h``'s leading (n, n) block replaced by its symmetric part, so the assembled
+    Hessian is symmetric to the last bit (the chain rule's two orders of
+    differentiation round differently)."""
+    for i in range(n):
+        for j in range(i):
+            mean = 0.5 * (h[i, j] + h[j, i])
+            h[i, j] = mean
+            h[j, i] = mean
+
+
+@njit(cache=True, inline="always")
+def _skew_at(u, a, b):
+    """Entry (a, b) of [u]×, the matrix of v ↦ u × v."""
+    turn = (b - a) % 3
+    if turn == 0:
+        return 0.0
+    return -u[3 - a - b] if turn == 1 else u[3 - a - b]
+
+
+@njit(cache=True)
+def _normal_gradient_jacobians(s, w, ww, r, e, sign, out_r, out_e):
+    """Jacobians (3, 3) of a tip's gradient g = −s w / (w·w) (s = |e|, w the triangle's
+    normal: w = r × e for the left tip (``sign`` 1: ∂w/∂r = −[e]×, ∂w/∂e = [r]×), w =
+    e × r for the right (``sign`` −1: ∂w/∂r = [e]×, ∂w/∂e = −[r]×)) with respect to
+    the tip's vector r (into ``out_r``) and the edge e (into ``out_e``)."""
+    for i in range(3):
+        for j in range(3):
+            # P = I − 2 w wᵀ / (w·w): the derivative of w / (w·w) is P / (w·w) ∂w
+            pr = 0.0
+            pe = 0.0
+            for l in range(3):
+                proj = (1.0 if i == l else 0.0) - 2.0 * w[i] * w[l] / ww
+                pr += proj * (-sign * _skew_at(e, l, j))
+                pe += proj * (sign * _skew_at(r, l, j))
+            out_r[i, j] = -s / ww * pr
+            out_e[i, j] = -s / ww * pe - w[i] * e[j] / (s * ww)
+
+
+@njit(cache=True)
+def fold_angle_hessian(p, g, h):
+    """∂φ/∂p into ``g`` (4, 3) and ∂²φ/∂p² into ``h`` (12, 12) of hinge points ``p``
+    (4, 3) = (a, b, c, d): the derivatives of :func:`fold_angle_gradient`'s
+    expressions (g_c = −|e| m / |m|², g_d = −|e| n / |n|², g_b = −s_c g_c − s_d g_d,
+    g_a = −g_b − g_c − g_d, s = r·e / |e|²), by the chain rule through r_c = c − a,
+    r_d = d − a, e = b − a; False (both zero) where :func:`fold_angle_gradient`
+    finds a triangle degenerate."""
+    h[:, :] = 0.0
+    if not fold_angle_gradient(p, g):
+        return False
+    e = _vec(p, 1, 0)
+    rc, rd = _vec(p, 2, 0), _vec(p, 3, 0)
+    m, n = _cross(rc, e), _cross(e, rd)
+    ee, mm, nn = _dot(e, e), _dot(m, m), _dot(n, n)
+    le = math.sqrt(ee)
+    jac = np.empty((4, 3, 3))  # ∂g_c/∂r_c, ∂g_c/∂e, ∂g_d/∂r_d, ∂g_d/∂e
+    _normal_gradient_jacobians(le, m, mm, rc, e, 1.0, jac[0], jac[1])
+    _normal_gradient_jacobians(le, n, nn, rd, e, -1.0, jac[2], jac[3])
+    sc, sd = _dot(rc, e) / ee, _dot(rd, e) / ee
+    # through r_c = c − a, r_d = d − a, e = b − a: per point k (a, b, c, d) the
+    # weights of ∂/∂r and ∂/∂e in ∂/∂p_k
+    on_r = ((-1.0, 0.0, 1.0, 0.0), (-1.0, 0.0, 0.0, 1.0))  # r_c, r_d
+    on_e = (-1.0, 1.0, 0.0, 0.0)
+    for k in range(4):
+        for j in range(3):
+            col = 3 * k + j
+            # ∂s_c/∂p_k, ∂s_d/∂p_k (component j): ∂s/∂r = e / ee, ∂s/∂e = (r − 2 s e) / ee
+            dsc = (on_r[0][k] * e[j] + on_e[k] * (rc[j] - 2.0 * sc * e[j])) / ee
+            dsd = (on_r[1][k] * e[j] + on_e[k] * (rd[j] - 2.0 * sd * e[j])) / ee
+            for i in range(3):
+                dgc = on_r[0][k] * jac[0, i, j] + on_e[k] * jac[1, i, j]
+                dgd = on_r[1][k] * jac[2, i, j] + on_e[k] * jac[3, i, j]
+                gb = -g[2, i] * dsc - sc * dgc - g[3, i] * dsd - sd * dgd
+                h[3 + i, col] = gb
+                h[6 + i, col] = dgc
+                h[9 + i, col] = dgd
+                h[i, col] = -gb - dgc - dgd
+    return True
+
+
+@njit(cache=True)
 def _bar_gradient(p, k, rest, g):
     d = _vec(p, 1, 0)
     length = math.sqrt(_dot(d, d))
@@ -146,6 +226,22 @@ def _hinge_gradient(p, k, target, reference, g):
 
 
 @njit(cache=True)
+def _hinge_hessian(p, k, target, reference, h):
+    """The Hessian (12, 12) of a hinge's energy ½ k (φ − φ̄)² into ``h``:
+    k (∇φ ∇φᵀ + (φ − φ̄) ∇²φ) (zero where a triangle is degenerate, as its
+    gradient is)."""
+    g = np.empty((4, 3))
+    if not fold_angle_hessian(p, g, h):
+        return
+    miss = fold_angle(p, reference) - target
+    for i in range(12):
+        gi = g[i // 3, i % 3]
+        for j in range(12):
+            h[i, j] = k * (gi * g[j // 3, j % 3] + miss * h[i, j])
+    _symmetrise(h, 12)
+
+
+@njit(cache=True)
 def _corner(p, i, j, l, k, rest, g):
     """Add ½ k (α − rest)² of the corner at p[i] (between p[j], p[l]), plus the sliver
     barrier below ``SLIVER`` × rest, and its gradient into g; returns the energy."""
@@ -175,31 +271,84 @@ def _corner(p, i, j, l, k, rest, g):
 
 
 @njit(cache=True)
+def _corner_hessian(p, i, j, l, k, rest, h, work):
+    """Add the Hessian of ½ k (α − rest)² of the corner at p[i] (between p[j], p[l])
+    into ``h`` (9, 9, point-major): k (∇α ∇αᵀ + (α − rest) ∇²α), with u = p[j] − p[i],
+    v = p[l] − p[i], n = u × v / |u × v|, ∂α/∂u = −n × u / |u|², ∂α/∂v = n × v / |v|²
+    (:func:`_corner`'s) differentiated through n: ∂n = (I − n nᵀ)(u × ∂v − v × ∂u) / |u × v|;
+    ``work`` (60,) scratch."""
+    u, v = _vec(p, j, i), _vec(p, l, i)
+    w = _cross(u, v)
+    s = math.sqrt(_dot(w, w))
+    uu, vv = _dot(u, u), _dot(v, v)
+    if s <= 1e-30 * (uu + vv) or uu <= 0.0 or vv <= 0.0:
+        return
+    alpha = math.atan2(s, _dot(u, v))
+    n = (w[0] / s, w[1] / s, w[2] / s)
+    nu, nv = _cross(n, u), _cross(n, v)
+    grad = work[:6].reshape(2, 3)  # ∂α/∂u, ∂α/∂v
+    dn = work[6:24].reshape(2, 3, 3)  # ∂n/∂u, ∂n/∂v
+    block = work[24:60].reshape(2, 2, 3, 3)  # ∂²α/∂(u, v)²
+    for a in range(3):
+        grad[0, a], grad[1, a] = -nu[a] / uu, nv[a] / vv
+        for b in range(3):
+            du = 0.0
+            dv = 0.0
+            for c in range(3):
+                proj = ((1.0 if a == c else 0.0) - n[a] * n[c]) / s
+                du -= proj * _skew_at(v, c, b)
+                dv += proj * _skew_at(u, c, b)
+            dn[0, a, b], dn[1, a, b] = du, dv
+    for a in range(3):
+        for b in range(3):
+            for q in range(2):  # derivative with respect to u (0) or v (1)
+                turn_u = 0.0  # −[u]× ∂n/∂q
+                turn_v = 0.0  # −[v]× ∂n/∂q
+                for c in range(3):
+                    turn_u -= _skew_at(u, a, c) * dn[q, c, b]
+                    turn_v -= _skew_at(v, a, c) * dn[q, c, b]
+                block[0, q, a, b] = -turn_u / uu
+                block[1, q, a, b] = turn_v / vv
+            block[0, 0, a, b] += -_skew_at(n, a, b) / uu + 2.0 * nu[a] * u[b] / (uu * uu)
+            block[1, 1, a, b] += _skew_at(n, a, b) / vv - 2.0 * nv[a] * v[b] / (vv * vv)
+    slope, curvature = k * (alpha - rest), k  # dE/dα, d²E/dα²
+    ratio = alpha / rest if rest > 0.0 else 1.0
+    if ratio < SLIVER:  # the sliver barrier k (SLIVER / r − 1)², r = α / rest
+        slope -= 2.0 * k * (SLIVER / ratio - 1.0) * SLIVER / (ratio * ratio * rest)
+        curvature += 2.0 * k * SLIVER / (rest * rest) * (
+            SLIVER / ratio ** 4 + 2.0 * (SLIVER / ratio - 1.0) / ratio ** 3)
+    points = (i, j, l)
+    # point r's coordinates enter u with weight cu[r], v with cv[r]
+    cu, cv = (-1.0, 1.0, 0.0), (-1.0, 0.0, 1.0)
+    for r in range(3):
+        for t in range(3):
+            for a in range(3):
+                gr = cu[r] * grad[0, a] + cv[r] * grad[1, a]
+                for b in range(3):
+                    gt = cu[t] * grad[0, b] + cv[t] * grad[1, b]
+                    second = (cu[r] * cu[t] * block[0, 0, a, b] + cu[r] * cv[t] * block[0, 1, a, b]
+                              + cv[r] * cu[t] * block[1, 0, a, b]
+                              + cv[r] * cv[t] * block[1, 1, a, b])
+                    h[3 * points[r] + a, 3 * points[t] + b] += curvature * gr * gt + slope * second
+
+
+@njit(cache=True)
+def _triangle_hessian(p, k, rest, h):
+    """The Hessian (9, 9) of a triangle's corner-angle energy into ``h``'s first 9 rows
+    and columns (the rest zero)."""
+    h[:, :] = 0.0
+    work = np.empty(60)
+    _corner_hessian(p, 0, 1, 2, k, rest[0], h, work)
+    _corner_hessian(p, 1, 2, 0, k, rest[1], h, work)
+    _corner_hessian(p, 2, 0, 1, k, rest[2], h, work)
+    _symmetrise(h, 9)
+
+
+@njit(cache=True)
 def _triangle_gradient(p, k, rest, g):
     g[:] = 0.0
     return (_corner(p, 0, 1, 2, k, rest[0], g) + _corner(p, 1, 2, 0, k, rest[1], g)
             + _corner(p, 2, 0, 1, k, rest[2], g))
-
-
-@njit(cache=True)
-def _element_size(p, size):
-    """The element's smallest height (or a bar's length): the scale its forces change
-    over, so the difference step of its Hessian is a fixed share of it (a sliver
-    triangle 1e-6 high needs steps well below 1e-6)."""
-    if size == 2:
-        d = _vec(p, 1, 0)
-        return max(math.sqrt(_dot(d, d)), 1e-300)
-    smallest = math.inf
-    for i in range(size):  # each side of each triangle, the height over it
-        for j in range(i + 1, size):
-            e = _vec(p, j, i)
-            le = math.sqrt(_dot(e, e))
-            smallest = min(smallest, le)
-            for k in range(size):
-                if k != i and k != j and (size == 3 or (i, j) == (0, 1)):
-                    n = _cross(e, _vec(p, k, i))
-                    smallest = min(smallest, math.sqrt(_dot(n, n)) / max(le, 1e-300))
-    return max(smallest, COLLAPSED)
 
 
 @njit(cache=True)
@@ -244,24 +393,10 @@ def evaluate(x, nodes, sizes, kinds, stiffness, rest, reference, energy, gradien
             continue
         if kinds[e] == 0:
             _bar_hessian(p, stiffness[e], rest[e, 0], hessian[e])
-            continue
-        gp = np.zeros((size, 3))
-        step = STEP * _element_size(p, size)
-        for a in range(size):
-            for c in range(3):
-                keep = p[a, c]
-                p[a, c] = keep + step
-                _element_gradient(kinds[e], p, stiffness[e], rest[e], reference[e], gp)
-                p[a, c] = keep
-                column = 3 * a + c
-                for b in range(size):
-                    for d in range(3):
-                        hessian[e, 3 * b + d, column] = (gp[b, d] - g[b, d]) / step
-        for i in range(3 * size):  # symmetric: the mean of the two differences
-            for j in range(i):
-                mean = 0.5 * (hessian[e, i, j] + hessian[e, j, i])
-                hessian[e, i, j] = mean
-                hessian[e, j, i] = mean
+        elif kinds[e] == 1:
+            _hinge_hessian(p, stiffness[e], rest[e, 0], reference[e], hessian[e])
+        else:
+            _triangle_hessian(p, stiffness[e], rest[e], hessian[e])
 
 
 @njit(cache=True, parallel=True)
