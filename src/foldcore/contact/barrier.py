@@ -39,7 +39,7 @@ TIGHT_GAP = 1e-3
 MAX_STIFFENING = 1e8
 
 
-def _ipctk():
+def load_ipctk():
     """ipctk, its sums pinned to one thread: with its default threads the same run
     gave different results at rounding level from one time to the next (reductions
     in a varying order), which contact's cut steps carry on to the fold; each call
@@ -138,7 +138,7 @@ class ContactModel:
         self.n_vertices = mesh.n_vertices
         self._rest = mesh.rest_positions
         self._meshes: dict = {}
-        ipctk = _ipctk()
+        ipctk = load_ipctk()
         self._potential = self._potentials()
         self._ccd = ipctk.AdditiveCCD(conservative_rescaling=CCD_RESCALING)
         self.obstacles = ObstacleContacts(self.solids, obstacles, self._potential[False],
@@ -149,7 +149,7 @@ class ContactModel:
 
     def _potentials(self) -> dict:
         """The barrier potentials of unjoined (False) and joined (True) pairs at κ."""
-        ipctk = _ipctk()
+        ipctk = load_ipctk()
         return {False: ipctk.BarrierPotential(self.dhat, self.kappa),
                 # κ × d̂/d̂_j: a force at a gap of d̂_j/2 as large as κ's at d̂/2 … within a
                 # factor ln: of the variants tried (×1, ×d̂/d̂_j, ×(d̂/d̂_j)²) the fewest steps
@@ -258,7 +258,7 @@ class ContactModel:
         """ipctk's collision mesh of two prisms: rest (n, 3) their corners (a's
         first), faces_a/faces_b their triangles (local indices), each body only
         against the other."""
-        ipctk = _ipctk()
+        ipctk = load_ipctk()
         n_a = int(faces_a.max()) + 1
         faces = np.vstack([faces_a, faces_b + n_a]).astype(np.int32)
         mesh = ipctk.CollisionMesh(np.asfortranarray(rest), ipctk.edges(faces), faces)
@@ -271,7 +271,7 @@ class ContactModel:
         """The contacts at positions x (N, 3); ``joined``: also between panels a crease
         joins (a strategy with exactly rigid panels; otherwise their hinge holds
         them)."""
-        ipctk = _ipctk()
+        ipctk = load_ipctk()
         pairs, gaps, energy, terms, kinds = [], [], 0.0, [], []
         for joined, (a, b), mesh, ids, pull, local in self._terms_at(x, joined):
             dhat, potential = (self.dhat_joined if joined else self.dhat), self._potential[joined]
@@ -309,7 +309,7 @@ class ContactModel:
     def hessian_blocks(self, state: ContactState):
         """Each barrier term's (model vertex ids (n,), PSD-projected block of
         ∂²(κ Σ b)/∂x² over their dofs, (3n, 3n) sparse, mm³)."""
-        ipctk = _ipctk()
+        ipctk = load_ipctk()
         for ids, collisions, mesh, local, potential, pull in state._terms:
             block = potential.hessian(collisions, mesh, local, ipctk.PSDProjectionMethod.CLAMP)
             if pull is not None:
@@ -355,7 +355,7 @@ class ContactModel:
         pairs = s.pairs_near(np.minimum(lo0, lo1), np.maximum(hi0, hi1), 0.0)
         if len(pairs):
             pairs = pairs[s.gap_bounds(x0, pairs, later=x1) <= 0.0]
-        ipctk = _ipctk()
+        ipctk = load_ipctk()
         fraction = 1.0
         for a, b in pairs:
             mesh, ids, _ = self._pair_mesh(int(a), int(b))
@@ -380,7 +380,7 @@ class ContactModel:
     def overlapping(self, x: np.ndarray) -> np.ndarray:
         """(K, 2) unjoined panel pairs whose surfaces intersect at x (a check, not a
         step's work)."""
-        ipctk = _ipctk()
+        ipctk = load_ipctk()
         found = []
         for a, b in self.candidates(x, 0.0):
             mesh, ids, _ = self._pair_mesh(int(a), int(b))
