@@ -86,7 +86,7 @@ def test_library_call_gives_the_sheet_fold_and_a_thickness_still_gives_a_thick_o
 
 @pytest.mark.parametrize("flag", [["--hinge", "arc"], ["--hinge-width", "1"],
                                   ["--elastic-cells", "5"], ["--solver", "newton"],
-                                  ["--contact", "on"]])
+                                  ["--ground", "0"]])
 def test_options_of_a_thick_sheet_are_refused_before_any_work(miura_file, tmp_path, capsys,
                                                               flag):
     out = tmp_path / "r.fold"

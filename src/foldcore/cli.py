@@ -266,8 +266,8 @@ def _add_solving(sim) -> None:
                           "barrier and collision-checked steps; solvers hybrid, rigid, "
                           "newton, lbfgs; needs the ipctk package): auto (default) wherever "
                           "the run can (thick rigid panels, no cuts, axis or slack hinges), "
-                          "on (refused where it cannot be), off; on with --obstacle or "
-                          "--ground")
+                          "on (refused where it cannot be; a thin sheet's triangles never "
+                          "pass through each other), off; on with --obstacle or --ground")
     sim.add_argument("--obstacle", action="append", default=[], metavar="MESH",
                      help="a fixed obstacle the sheet touches but never passes: a mesh file "
                           "(STL, OBJ, PLY, ... read by meshio) in mm in the pattern's frame "

@@ -7,8 +7,10 @@ creases springs toward their targets (:mod:`foldcore.sheet`), settled to
 equilibrium by Newton's method. One line says so. A series or an animation
 folds it from flat through the fold percents of the sweep, each frame from
 the last (:func:`sweep_thin`). The options of a thick sheet (hinges,
-strategies, contact) have no meaning here: each one set is refused, naming
-it, before any work.
+strategies, obstacles) have no meaning here: each one set is refused, naming
+it, before any work. ``solving.contact`` ``"on"`` keeps the sheet's triangles
+from passing through each other (:mod:`foldcore.contact.sheet`); ``"auto"``
+and ``"off"`` fold Origami Simulator's model, which lets them.
 """
 from __future__ import annotations
 
@@ -27,7 +29,7 @@ THIN_NOTE = ("no thickness given: folded as a thin sheet (Origami Simulator's mo
 THICK_ONLY = (("thickening", Thickening, ("hinge_width", "subdivisions", "hinge",
                                           "elastic_cells")),
               ("solving", Solving, ("solver", "actuation", "branch_floor", "strategy_options",
-                                    "contact", "obstacles", "ground")))
+                                    "obstacles", "ground")))
 
 
 def thick_options_set(job) -> list[str]:
@@ -70,7 +72,8 @@ def run_thin(job, loaded, on_start=None, callback=None):
                       f"drawing (each follows its merged edge)", RunWarning, stacklevel=3)
     sweeping = bool(job.outputs.series or job.outputs.animate)
     solver = None if sweeping else SheetSolver(sheet, s.fold_percent,
-                                               pattern_edges=pattern.n_edges)
+                                               pattern_edges=pattern.n_edges,
+                                               contact=thin_contact(job))
     setup = time.perf_counter() - t0
     if on_start is not None:
         on_start()
@@ -101,7 +104,8 @@ def sweep_thin(job, sheet, pattern) -> tuple[list, object]:
     s, out = job.solving, job.outputs
     sweep, start, steps = [], None, 0
     for percent in percent_schedule(out.frames, s.fold_percent):
-        solver = SheetSolver(sheet, float(percent), start=start, pattern_edges=pattern.n_edges)
+        solver = SheetSolver(sheet, float(percent), start=start, pattern_edges=pattern.n_edges,
+                             contact=thin_contact(job))
         fold = solver.run(s.tolerance, s.budget(SHEET_BUDGET))
         steps = fold.iterations = steps + fold.iterations  # from the sweep's start, as thick
         sweep.append((float(percent), fold))
@@ -161,9 +165,15 @@ def _callback(callback):
     return step
 
 
+def thin_contact(job) -> bool:
+    """Whether ``job``'s thin sheet keeps its triangles apart: only where contact is
+    asked for (``"on"``); ``"auto"`` folds Origami Simulator's model."""
+    return job.solving.contact == "on"
+
+
 def thin_settings(job) -> dict:
     """What the report records of a thin-sheet run's settings."""
     s = job.solving
     return {"pattern": job.source, "model": "sheet", "fold_percent": s.fold_percent,
             "tolerance": s.tolerance, "max_iterations": s.budget(SHEET_BUDGET),
-            "thickness_mm": None}
+            "thickness_mm": None, "contact": "on" if thin_contact(job) else "off"}

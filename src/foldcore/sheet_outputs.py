@@ -56,6 +56,7 @@ def sheet_report(fold, pattern, sheet, settings: dict) -> dict:
                   "sliver_corners": int(fold.sliver_corners),
                   "radius_mm": float(sheet.radius),
                   "stiffness": asdict(sheet.constants)},
+        "contact": fold.contact,
         "timings_s": {k: float(v) for k, v in fold.timings_s.items()},
         "settings": settings,
         "machine": machine_entries(),

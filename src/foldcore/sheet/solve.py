@@ -10,6 +10,10 @@ energy. μ (Levenberg–Marquardt) keeps the matrix positive definite away from
 the minimum (the Hessian of a hinge far from its target is indefinite) and
 fixes the six rigid motions, which the energy does not see; it shrinks as
 steps succeed, so the last steps are Newton's, quadratically convergent.
+
+With ``contact`` the sheet's triangles never pass through each other: IPC's
+barrier joins the energy and every step is shortened to the share of it that
+no two triangles cross on (:mod:`foldcore.contact.sheet`).
 """
 from __future__ import annotations
 
@@ -55,6 +59,10 @@ class SheetFold:
     sliver_corners : int, triangle corners closed below
         :data:`~.kernels.SLIVER` of their rest angle at the end: held open by the
         sliver barrier, where the facet would otherwise collapse
+    contact : dict or None, with self-contact: ``activation_mm`` (d̂),
+        ``active_pairs`` (primitive pairs within d̂ at the end), ``smallest_gap_mm``
+        (None where none is within d̂), ``stiffness`` (κ at the end, relative to its
+        start); None without
     """
 
     positions: np.ndarray
@@ -68,6 +76,7 @@ class SheetFold:
     energy: float
     timings_s: dict
     sliver_corners: int = 0
+    contact: dict | None = None
 
 
 class Assembly:
@@ -149,11 +158,12 @@ class Energy:
 
 def fold_sheet(sheet: Sheet, fold_percent: float = 100.0, start: np.ndarray | None = None,
                tolerance: float = TOLERANCE, max_iterations: int = SHEET_BUDGET,
-               backend: str = "auto", pattern_edges: int | None = None) -> SheetFold:
+               backend: str = "auto", pattern_edges: int | None = None,
+               contact: bool = False) -> SheetFold:
     """Settle ``sheet`` at ``fold_percent`` (of every crease's target), from flat or
     from ``start`` (V, 3) mm, one per pattern vertex; see the module docstring and
     :class:`SheetSolver`."""
-    solver = SheetSolver(sheet, fold_percent, start, backend, pattern_edges)
+    solver = SheetSolver(sheet, fold_percent, start, backend, pattern_edges, contact)
     return solver.run(tolerance, max_iterations)
 
 
@@ -168,6 +178,9 @@ class SheetSolver:
     backend : {"auto", "cholmod", "scipy"}, the sparse factorisation
     pattern_edges : int, optional, the pattern's edge count (``fold_angles_deg``'s
         length; default the largest edge id the sheet uses + 1)
+    contact : bool, keep the triangles from passing through each other
+        (:mod:`foldcore.contact.sheet`; needs ipctk); default False, Origami
+        Simulator's model
 
     ``x`` (N, 3, normalised) and ``iterations`` hold the last accepted iterate, so
     a run stopped by Ctrl-C still gives its :meth:`result`.
@@ -175,7 +188,7 @@ class SheetSolver:
 
     def __init__(self, sheet: Sheet, fold_percent: float = 100.0,
                  start: np.ndarray | None = None, backend: str = "auto",
-                 pattern_edges: int | None = None):
+                 pattern_edges: int | None = None, contact: bool = False):
         self.sheet, self.backend, self.pattern_edges = sheet, backend, pattern_edges
         self.energy = Energy(sheet, fold_percent)
         self.assembly = Assembly(sheet)
@@ -183,8 +196,37 @@ class SheetSolver:
         self.energy.settle_references(self.x)
         self.iterations, self.seconds = 0, 0.0
         self.unit_force = unit_force(sheet)
+        self.contact = None
+        if contact:
+            from ..contact.sheet import SheetContact
+
+            self.contact = SheetContact(sheet.flat, sheet.triangles, self.unit_force)
+        self.touch = self._trial_touch = None  # contacts at x, at the last trial
+        self._evaluate()
+
+    def _evaluate(self) -> None:
+        """Energy, gradient and the elements' Hessians (and the contacts) at x."""
         self.value = self.energy(self.x, want_hessian=True)
         self.gradient = self.assembly.gradient(self.energy.gradients)
+        if self.contact is not None:
+            self.touch = self.contact.touch(self.x)
+            self.value += self.touch.energy
+            self.gradient = self.gradient + self.contact.gradient(self.touch, self.x)
+
+    def _trial_energy(self, trial: np.ndarray) -> float:
+        """The energy at a trial point (with its contacts)."""
+        value = self.energy(trial)
+        if self.contact is not None:
+            self._trial_touch = self.contact.touch(trial)
+            value += self._trial_touch.energy
+        return value
+
+    def _trial_force(self, trial: np.ndarray) -> float:
+        """The largest gradient entry at the trial last evaluated."""
+        gradient = self.assembly.gradient(self.energy.gradients)
+        if self.contact is not None:
+            gradient = gradient + self.contact.gradient(self._trial_touch, trial)
+        return float(np.max(np.abs(gradient)))
 
     @property
     def residual(self) -> float:
@@ -197,6 +239,8 @@ class SheetSolver:
         if not len(self.gradient):
             return 0.0
         meeting = self.assembly.node_force_sums(self.energy.gradients)
+        if self.contact is not None:
+            meeting = meeting + self.contact.node_forces(self.touch, self.x)
         imbalance = np.linalg.norm(self.gradient.reshape(-1, 3), axis=1)
         return float(np.max(imbalance / (meeting + self.unit_force)))
 
@@ -229,31 +273,45 @@ class SheetSolver:
     def _step(self, mu, factor):
         """(μ, factor, x or None): one damped Newton step, μ raised until one lowers
         the energy (None when none does)."""
+        if self.contact is not None and self.contact.stiffen(self.touch):
+            self._evaluate()  # κ doubled: E and its gradient anew
         data = self.assembly.hessian_values(self.energy.hessians)
         diagonal = np.abs(data[self.assembly.diagonal])
         scale = diagonal + max(float(np.median(diagonal)), 1e-300)
+        extra = None if self.contact is None else self.contact.hessian(self.touch, self.x)
         while True:
             step, factor, mu = _regularised_step(self.assembly, data, self.gradient, mu, scale,
-                                                 factor, self.backend)
+                                                 factor, self.backend, extra)
             if step is None:
                 return mu, factor, None
-            moved, value, full = _line_search(self.energy, self.assembly, self.x, self.value,
-                                              self.gradient, step)
+            share = 1.0 if self.contact is None else \
+                self.contact.free_share(self.x, self.x + step.reshape(-1, 3))
+            moved, value, full = _line_search(self._trial_energy, self._trial_force, self.x,
+                                              self.value, self.gradient, step, share)
             if moved is not None:
                 break
             mu *= 10.0
             if mu >= MU_CEILING:
                 return mu, factor, None
-        self.x, self.value, self.iterations = moved, value, self.iterations + 1
+        self.x, self.iterations = moved, self.iterations + 1
         self.energy.settle_references(self.x)
-        self.value = self.energy(self.x, want_hessian=True)
-        self.gradient = self.assembly.gradient(self.energy.gradients)
+        self._evaluate()
         return (max(mu / 3.0, MU_FLOOR) if full else min(mu * 4.0, MU_CEILING)), factor, moved
 
     def result(self, reason: str) -> SheetFold:
         """The current iterate as a :class:`SheetFold` ending for ``reason``."""
-        return _fold(self.sheet, self.energy, self.x, self.iterations, reason, self.residual,
+        fold = _fold(self.sheet, self.energy, self.x, self.iterations, reason, self.residual,
                      self.value, self.seconds, self.pattern_edges)
+        if self.contact is not None:
+            fold.contact = self._contact_report()
+        return fold
+
+    def _contact_report(self) -> dict:
+        """:attr:`SheetFold.contact` at x."""
+        radius, touch, c = self.sheet.radius, self.touch, self.contact
+        return {"activation_mm": c.dhat * radius, "active_pairs": int(touch.pairs),
+                "smallest_gap_mm": touch.gap * radius if touch.active else None,
+                "stiffness": c.stiffening}
 
 
 def unit_force(sheet: Sheet) -> float:
@@ -267,13 +325,18 @@ def unit_force(sheet: Sheet) -> float:
     return float(np.median(k / tip_heights(sheet.flat, hinges).min(axis=1)))
 
 
-def _regularised_step(assembly: Assembly, data, gradient, mu, scale, factor, backend):
+def _regularised_step(assembly: Assembly, data, gradient, mu, scale, factor, backend,
+                      extra=None):
     """(step, factor, μ): the solution of (H + μ·diag(scale)) Δ = −g, raising μ until the
-    matrix factors; (None, factor, μ) when it never does."""
+    matrix factors; (None, factor, μ) when it never does. ``extra``: a sparse matrix
+    added to H (the contacts'), whose pattern changes from step to step: the
+    factor is then analysed anew and not kept."""
     while mu < MU_CEILING:
         shifted = data.copy()
         shifted[assembly.diagonal] += mu * scale
         matrix = assembly.matrix(shifted)
+        if extra is not None:
+            matrix, factor = (matrix + extra).tocsc(), None
         try:
             if factor is None:
                 factor = Factor(matrix, backend)
@@ -281,32 +344,34 @@ def _regularised_step(assembly: Assembly, data, gradient, mu, scale, factor, bac
                 factor.refactor(matrix)
             step = -factor.solve(gradient)
             if np.all(np.isfinite(step)):
-                return step, factor, mu
+                return step, (None if extra is not None else factor), mu
         except not_positive_definite():
             factor = None
         mu *= 10.0
     return None, factor, mu
 
 
-def _line_search(energy: Energy, assembly: Assembly, x, value, gradient, step):
-    """(x + t·step, its energy, t == 1) for the largest t = 2⁻ᵏ meeting Armijo's
-    condition, or, where the energy's change is below its rounding
+def _line_search(energy, largest_force, x, value, gradient, step, share: float = 1.0):
+    """(x + t·step, its energy, t == ``share``) for the largest t = share · 2⁻ᵏ meeting
+    Armijo's condition, or, where the energy's change is below its rounding
     (:data:`ROUNDOFF`), lowering the largest force instead; (None, value, False)
-    when no t does."""
+    when no t does. ``energy(trial)`` gives the energy at a trial,
+    ``largest_force(trial)`` its largest gradient entry after that; ``share``
+    the step's collision-free share (1 without contact)."""
     slope = float(gradient @ step)
-    if slope >= 0.0:
+    if slope >= 0.0 or share <= 0.0:
         return None, value, False
-    t = 1.0
+    t = share
     flat_step = step.reshape(-1, 3)
     force = float(np.max(np.abs(gradient)))
     for _ in range(HALVINGS):
         trial = x + t * flat_step
         trial_value = energy(trial)
         if trial_value <= value + ARMIJO * t * slope:
-            return trial, trial_value, t == 1.0
+            return trial, trial_value, t == share
         if abs(trial_value - value) <= ROUNDOFF * abs(value) and \
-                np.max(np.abs(assembly.gradient(energy.gradients))) < force:
-            return trial, trial_value, t == 1.0  # below the energy's rounding: the forces
+                largest_force(trial) < force:
+            return trial, trial_value, t == share  # below the energy's rounding: the forces
         t *= 0.5
     return None, value, False
 

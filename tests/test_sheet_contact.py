@@ -1,0 +1,125 @@
+"""A thin sheet with contact: its triangles never pass through each other.
+
+Origami Simulator's ``miura-ori.svg`` at 90 % asks some creases for more than
+180° (its opacities), so Origami Simulator's model folds facets through each
+other. The crossings are counted here by a segment–triangle test of the
+test's own (Möller–Trumbore), not by the library the contact uses.
+"""
+from __future__ import annotations
+
+import json
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from foldcore import cli
+from foldcore.errors import PatternWarning
+from foldcore.io import read_file
+from foldcore.sheet import SheetSolver, build_sheet
+
+pytest.importorskip("ipctk")
+
+MIURA = Path(__file__).parent / "data" / "real" / "miura-ori.svg"
+
+
+def crossings(x: np.ndarray, triangles: np.ndarray) -> int:
+    """Edges of the triangles that pass through a triangle sharing no vertex with them
+    (a touch within 1e-12 of the sheet's size does not count)."""
+    edges = np.unique(np.sort(np.vstack([triangles[:, [0, 1]], triangles[:, [1, 2]],
+                                         triangles[:, [2, 0]]]), axis=1), axis=0)
+    a, b, c = (x[triangles[:, k]] for k in range(3))
+    e1, e2 = b - a, c - a
+    eps = 1e-12 * np.ptp(x, axis=0).max()
+    count = 0
+    for i, j in edges:
+        far = ~np.any(triangles == i, axis=1) & ~np.any(triangles == j, axis=1)
+        d = x[j] - x[i]
+        p = np.cross(d, e2[far])
+        det = np.einsum("ij,ij->i", e1[far], p)
+        ok = np.abs(det) > 1e-300
+        s = x[i] - a[far]
+        u = np.einsum("ij,ij->i", s, p) / np.where(ok, det, 1.0)
+        q = np.cross(s, e1[far])
+        v = (q @ d) / np.where(ok, det, 1.0)
+        t = np.einsum("ij,ij->i", e2[far], q) / np.where(ok, det, 1.0)
+        margin = eps / np.linalg.norm(d)
+        inside = ok & (u > margin) & (v > margin) & (u + v < 1 - margin) & \
+            (t > margin) & (t < 1 - margin)
+        count += int(inside.sum())
+    return count
+
+
+@pytest.fixture(scope="module")
+def miura():
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", PatternWarning)
+        loaded = read_file(MIURA)
+    sheet = build_sheet(loaded.pattern, merge_straight=True, drawn=loaded.drawing)
+    return sheet, loaded.pattern
+
+
+def fold(miura, percent, contact):
+    sheet, pattern = miura
+    return SheetSolver(sheet, percent, pattern_edges=pattern.n_edges, contact=contact).run()
+
+
+def test_without_contact_the_facets_pass_through_each_other(miura):
+    result = fold(miura, 90, contact=False)
+    assert result.converged and result.contact is None
+    assert np.nanmax(np.abs(result.fold_angles_deg)) > 180.0
+    assert crossings(result.positions, miura[0].triangles) > 0  # the check can fail
+
+
+def test_with_contact_no_facet_passes_through_another(miura):
+    result = fold(miura, 90, contact=True)
+    assert result.converged
+    assert crossings(result.positions, miura[0].triangles) == 0
+    # the barrier holds the facets a crease would fold past flat: 180° at most
+    assert np.nanmax(np.abs(result.fold_angles_deg)) <= 180.0
+    c = result.contact
+    assert c["active_pairs"] > 0
+    assert 0.0 < c["smallest_gap_mm"] < c["activation_mm"]
+
+
+def test_a_contact_that_never_engages_changes_nothing(miura):
+    """At 60 % no two facets come within d̂: the fold is Origami Simulator's model's,
+    bit for bit."""
+    free, held = fold(miura, 60, contact=False), fold(miura, 60, contact=True)
+    assert held.contact["active_pairs"] == 0
+    assert np.array_equal(free.positions, held.positions)
+    assert held.iterations == free.iterations
+
+
+def test_command_line_thin_contact(tmp_path, capsys):
+    report = tmp_path / "r.json"
+    code = cli.main(["simulate", str(MIURA), "--fold-percent", "90", "--contact", "on",
+                     "-q", "--report", str(report)])
+    assert code == 0, capsys.readouterr().err
+    data = json.loads(report.read_text())
+    assert data["settings"]["contact"] == "on" and data["contact"]["active_pairs"] > 0
+    assert cli.main(["simulate", str(MIURA), "--fold-percent", "90", "-q",
+                     "--report", str(report)]) == 0
+    data = json.loads(report.read_text())
+    assert data["settings"]["contact"] == "off" and data["contact"] is None
+
+
+
+def test_a_long_step_through_a_facet_is_cut_short_of_it():
+    """A triangle 0.5 above another, moved 1.0 down through it (ten pieces of the
+    sweep): the share taken stops short of the touch at 0.5; moved sideways far
+    from it, the whole step is free."""
+    from foldcore.contact.sheet import MAX_SWEEP, SheetContact
+
+    flat = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0],
+                     [0.2, 0.2, 0.5], [0.5, 0.2, 0.5], [0.2, 0.5, 0.5]], dtype=float)
+    contact = SheetContact(flat, np.array([[0, 1, 2], [3, 4, 5]]), force=1.0)
+    down = flat.copy()
+    down[3:, 2] -= 1.0
+    assert 1.0 / MAX_SWEEP >= 10
+    share = contact.free_share(flat, down)
+    assert 0.4 < share < 0.5
+    aside = flat.copy()
+    aside[3:, 0] += 3.0
+    assert contact.free_share(flat, aside) == 1.0
