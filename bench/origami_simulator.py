@@ -158,6 +158,13 @@ HARNESS_JS = """
 """
 
 
+def add_source_argument(parser) -> None:
+    """``--origami-simulator PATH``: its snapshot (bare git dir or checkout), default
+    ``DEFAULT_SOURCE``, for a benchmark that reads its files."""
+    parser.add_argument("--origami-simulator", type=Path, default=DEFAULT_SOURCE,
+                        help=f"Origami Simulator's snapshot (default {DEFAULT_SOURCE})")
+
+
 def git(source: Path, *args: str, stdin: bytes | None = None) -> bytes:
     """Output of ``git --git-dir source args`` (raises on failure)."""
     return subprocess.run(["git", "--git-dir", str(source), *args], input=stdin,

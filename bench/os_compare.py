@@ -320,8 +320,7 @@ def plot(data: dict, path: Path) -> None:
 
 def main() -> None:
     p = _meta.parser(__doc__)
-    p.add_argument("--origami-simulator", type=Path,
-                   default=Path("/work/.mirror/amandaghassaei+OrigamiSimulator/repo"))
+    osim.add_source_argument(p)
     args = p.parse_args()
     if _meta.stored("os_compare", args, table, plot):
         return
