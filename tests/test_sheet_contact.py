@@ -123,3 +123,26 @@ def test_a_long_step_through_a_facet_is_cut_short_of_it():
     aside = flat.copy()
     aside[3:, 0] += 3.0
     assert contact.free_share(flat, aside) == 1.0
+
+
+def test_contact_on_a_cut_sheet_is_refused_naming_the_file(tmp_path, capsys):
+    """A cut's two sides lie on each other in the flat sheet: no d̂ keeps it outside
+    the barrier, so contact is refused in one line, before any output."""
+    from foldcore.io import write_fold
+    from foldcore.pattern import CreasePattern
+
+    xy = [(0, 0), (50, 0), (100, 0), (100, 50), (100, 100), (0, 100), (0, 50), (50, 50)]
+    border = [(0, 1), (1, 2), (2, 3), (3, 4), (4, 5), (5, 6), (6, 0)]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        pattern = CreasePattern(xy, border + [(6, 7), (7, 3), (1, 7)],
+                                ["B"] * 7 + ["V", "M", "C"],
+                                fold_angles=[None] * 7 + [90, -90, None])
+    source, out = tmp_path / "cut.fold", tmp_path / "r.fold"
+    write_fold(source, pattern)
+    assert cli.main(["simulate", str(source), "--contact", "on", "-o", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert f"{source}: contact needs the flat sheet's triangles apart" in err
+    assert "Traceback" not in err and err.count("foldcore: error") == 1
+    assert not out.exists()
+    assert cli.main(["simulate", str(source), "-q", "-o", str(out)]) == 0  # without: folds

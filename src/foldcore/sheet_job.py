@@ -57,7 +57,7 @@ def run_thin(job, loaded, on_start=None, callback=None):
     series or an animation asked for, ``sweep`` is :func:`sweep_thin`'s, the
     result its last frame and the solver that frame's (an interrupted sweep writes
     nothing, as a thick one); else None."""
-    from .sheet import SheetSolver, build_sheet
+    from .sheet import build_sheet
 
     warnings.warn(f"{job.source}: {THIN_NOTE}", RunWarning, stacklevel=3)
     s, pattern = job.solving, loaded.pattern
@@ -71,9 +71,7 @@ def run_thin(job, loaded, on_start=None, callback=None):
                       f"the thin sheet, their edges merged, as Origami Simulator reads a "
                       f"drawing (each follows its merged edge)", RunWarning, stacklevel=3)
     sweeping = bool(job.outputs.series or job.outputs.animate)
-    solver = None if sweeping else SheetSolver(sheet, s.fold_percent,
-                                               pattern_edges=pattern.n_edges,
-                                               contact=thin_contact(job))
+    solver = None if sweeping else thin_solver(job, sheet, pattern, s.fold_percent)
     setup = time.perf_counter() - t0
     if on_start is not None:
         on_start()
@@ -99,13 +97,11 @@ def sweep_thin(job, sheet, pattern) -> tuple[list, object]:
     (:func:`foldcore.sheet_render.render_sheet_frames`, one camera for all) and
     written as the animation."""
     from .animate import frame_titles, percent_schedule, write_animation
-    from .sheet import SheetSolver
 
     s, out = job.solving, job.outputs
     sweep, start, steps = [], None, 0
     for percent in percent_schedule(out.frames, s.fold_percent):
-        solver = SheetSolver(sheet, float(percent), start=start, pattern_edges=pattern.n_edges,
-                             contact=thin_contact(job))
+        solver = thin_solver(job, sheet, pattern, float(percent), start)
         fold = solver.run(s.tolerance, s.budget(SHEET_BUDGET))
         steps = fold.iterations = steps + fold.iterations  # from the sweep's start, as thick
         sweep.append((float(percent), fold))
@@ -163,6 +159,19 @@ def _callback(callback):
         last["x"] = x
         return callback(solver, moved)
     return step
+
+
+def thin_solver(job, sheet, pattern, percent: float, start=None):
+    """The :class:`foldcore.sheet.SheetSolver` of ``job``'s sheet at ``percent`` (from
+    ``start``, mm, or flat); a contact it cannot keep is refused naming the file."""
+    from .errors import SimulationError
+    from .sheet import SheetSolver
+
+    try:
+        return SheetSolver(sheet, percent, start=start, pattern_edges=pattern.n_edges,
+                           contact=thin_contact(job))
+    except SimulationError as exc:
+        raise SimulationError(f"{job.source}: {exc}") from None
 
 
 def thin_contact(job) -> bool:

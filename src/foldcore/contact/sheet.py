@@ -25,6 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
+from ..errors import SimulationError
 from .barrier import MAX_STIFFENING, TIGHT_GAP, load_ipctk
 
 #: d̂ of a thin sheet, a share of its bounding radius (0.1 %: 0.1 mm on a 10 cm sheet).
@@ -70,6 +71,12 @@ class SheetContact:
     triangles : (T, 3) int, the sheet's triangles
     force : float, the sheet's force scale (:func:`foldcore.sheet.solve.unit_force`):
         κ is set so that the barrier pushes with about this force at half of d̂
+
+    Raises
+    ------
+    SimulationError
+        Where two features that share no vertex touch in the flat sheet (a cut's
+        two sides): no d̂ keeps the flat sheet outside the barrier.
     """
 
     def __init__(self, flat: np.ndarray, triangles: np.ndarray, force: float):
@@ -77,7 +84,13 @@ class SheetContact:
         faces = np.ascontiguousarray(triangles, dtype=np.int32)
         self.mesh = ipctk.CollisionMesh(np.asfortranarray(flat, dtype=float),
                                         ipctk.edges(faces), faces)
-        self.dhat = min(SHEET_ACTIVATION, FLAT_CLEARANCE * self._flat_distance(flat))
+        apart = self._flat_distance(flat)
+        if not apart > 0.0:
+            raise SimulationError(
+                "contact needs the flat sheet's triangles apart, and here two of them "
+                "that share no vertex touch (the two sides of a cut or slit, or vertices "
+                "drawn on top of each other): fold it without contact")
+        self.dhat = min(SHEET_ACTIVATION, FLAT_CLEARANCE * apart)
         self.kappa = float(force) / self.dhat
         self._kappa_start, self._last_gap = self.kappa, np.inf
         self._ccd = ipctk.TightInclusionCCD()
