@@ -22,6 +22,8 @@ from foldcore.sheet import SheetSolver, build_sheet
 pytest.importorskip("ipctk")
 
 MIURA = Path(__file__).parent / "data" / "real" / "miura-ori.svg"
+#: From Origami Simulator's ``needsCollisions`` folder: its panels stack at 90 %.
+SOLAR = Path(__file__).parent / "data" / "real" / "byu-solar-driven.svg"
 
 
 def crossings(x: np.ndarray, triangles: np.ndarray) -> int:
@@ -51,13 +53,17 @@ def crossings(x: np.ndarray, triangles: np.ndarray) -> int:
     return count
 
 
-@pytest.fixture(scope="module")
-def miura():
+def sheet_of(path):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", PatternWarning)
-        loaded = read_file(MIURA)
+        loaded = read_file(path)
     sheet = build_sheet(loaded.pattern, merge_straight=True, drawn=loaded.drawing)
     return sheet, loaded.pattern
+
+
+@pytest.fixture(scope="module")
+def miura():
+    return sheet_of(MIURA)
 
 
 def fold(miura, percent, contact):
@@ -81,6 +87,17 @@ def test_with_contact_no_facet_passes_through_another(miura):
     c = result.contact
     assert c["active_pairs"] > 0
     assert 0.0 < c["smallest_gap_mm"] < c["activation_mm"]
+
+
+def test_a_file_that_needs_collisions_folds_without_passing_through_itself():
+    """Origami Simulator's own ``needsCollisions`` file: at 90 % its solar panels fold
+    through each other (a crease past 180°) in Origami Simulator's model; with
+    contact they stack, no crease past flat and no triangle through another."""
+    solar = sheet_of(SOLAR)
+    free, held = fold(solar, 90, contact=False), fold(solar, 90, contact=True)
+    assert crossings(free.positions, solar[0].triangles) > 0
+    assert held.converged and crossings(held.positions, solar[0].triangles) == 0
+    assert np.nanmax(np.abs(held.fold_angles_deg)) <= 180.0
 
 
 def test_a_contact_that_never_engages_changes_nothing(miura):
