@@ -163,3 +163,17 @@ def test_contact_on_a_cut_sheet_is_refused_naming_the_file(tmp_path, capsys):
     assert "Traceback" not in err and err.count("foldcore: error") == 1
     assert not out.exists()
     assert cli.main(["simulate", str(source), "-q", "-o", str(out)]) == 0  # without: folds
+
+
+def test_without_ipctk_contact_is_refused_in_one_line(tmp_path, capsys, monkeypatch):
+    from foldcore.contact import sheet as sheet_contact
+
+    def missing():
+        raise ImportError("No module named 'ipctk'")
+
+    monkeypatch.setattr(sheet_contact, "load_ipctk", missing)
+    out = tmp_path / "r.fold"
+    assert cli.main(["simulate", str(MIURA), "--contact", "on", "-o", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert f"{MIURA}: contact needs the ipctk package" in err and "Traceback" not in err
+    assert not out.exists()

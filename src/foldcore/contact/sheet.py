@@ -76,11 +76,16 @@ class SheetContact:
     ------
     SimulationError
         Where two features that share no vertex touch in the flat sheet (a cut's
-        two sides): no d̂ keeps the flat sheet outside the barrier.
+        two sides): no d̂ keeps the flat sheet outside the barrier; where ipctk is
+        not installed.
     """
 
     def __init__(self, flat: np.ndarray, triangles: np.ndarray, force: float):
-        ipctk = load_ipctk()
+        try:
+            ipctk = load_ipctk()
+        except ImportError:
+            raise SimulationError("contact needs the ipctk package, which is not "
+                                  "installed (pip install 'foldcore[contact]')") from None
         faces = np.ascontiguousarray(triangles, dtype=np.int32)
         self.mesh = ipctk.CollisionMesh(np.asfortranarray(flat, dtype=float),
                                         ipctk.edges(faces), faces)
