@@ -38,6 +38,11 @@ FLAT_CLEARANCE = 0.5
 #: meet, and checked whole, the long first Newton steps of Origami Simulator's
 #: ``rose.svg`` (2 858 triangles) at 60 % grew the run past 7.9 GB.
 MAX_SWEEP = 0.1
+#: Tight-Inclusion CCD's tolerance (ipctk's default 1e-6). Looser, it still never lets
+#: a step cross (its time of impact is a lower bound) but stops sooner; on Origami
+#: Simulator's byu solar file at 90 % 1e-3 took the fold from 8.6 to 2.6 s and
+#: on its Miura at 90 % from 1.3 to 1.1 s (1e-2: 1.7 s on both).
+CCD_TOLERANCE = 1e-3
 
 
 @dataclass
@@ -98,7 +103,7 @@ class SheetContact:
         self.dhat = min(SHEET_ACTIVATION, FLAT_CLEARANCE * apart)
         self.kappa = float(force) / self.dhat
         self._kappa_start, self._last_gap = self.kappa, np.inf
-        self._ccd = ipctk.TightInclusionCCD()
+        self._ccd = ipctk.TightInclusionCCD(tolerance=CCD_TOLERANCE)
         self._potential = ipctk.BarrierPotential(self.dhat, self.kappa)
 
     def _flat_distance(self, flat: np.ndarray) -> float:
