@@ -177,3 +177,34 @@ def test_without_ipctk_contact_is_refused_in_one_line(tmp_path, capsys, monkeypa
     err = capsys.readouterr().err
     assert f"{MIURA}: contact needs the ipctk package" in err and "Traceback" not in err
     assert not out.exists()
+
+
+def test_with_contact_no_step_turns_a_hinge_through_flat():
+    """Two triangles that share a crease: the barrier never checks them against each
+    other, so the solver refuses a trial that turns their hinge through ±180°."""
+    from foldcore.pattern import CreasePattern
+
+    square = CreasePattern([(0, 0), (100, 0), (100, 100), (0, 100)],
+                           [(0, 1), (1, 2), (2, 3), (3, 0), (0, 2)], list("BBBBV"),
+                           fold_angles=[None] * 4 + [90.0])
+    sheet = build_sheet(square)
+    solver = SheetSolver(sheet, 100.0, pattern_edges=square.n_edges, contact=True)
+    (a, b, c, d), = sheet.hinges[sheet.hinge_edge == 4]
+
+    def folded(degrees):
+        """The flat sheet with tip d turned about the crease a–b by ``degrees``."""
+        x = sheet.flat.copy()
+        axis = (x[b] - x[a]) / np.linalg.norm(x[b] - x[a])
+        r, t = x[d] - x[a], np.radians(degrees)
+        x[d] = x[a] + r * np.cos(t) + np.cross(axis, r) * np.sin(t) + \
+            axis * (axis @ r) * (1 - np.cos(t))
+        return x
+
+    near = folded(175.0)
+    solver.x = near
+    solver.energy.settle_references(near)
+    angle = abs(np.degrees(solver.result("x").hinge_angles[sheet.hinge_edge == 4][0]))
+    assert abs(angle - 175.0) < 1e-6
+    assert not solver._through_flat(folded(179.0))
+    assert solver._through_flat(folded(185.0))
+    assert solver._trial_energy(folded(185.0)) == np.inf

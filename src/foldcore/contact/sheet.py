@@ -15,9 +15,10 @@ thickness, which a thin sheet leaves out: a share of its size, smaller where
 two features of the flat sheet already lie closer (the flat sheet must start
 outside the barrier).
 
-Two triangles that share an edge are never checked against each other (every
-feature of one shares a vertex with the other): a crease whose facets have
-nothing else near can still fold through flat.
+Two triangles that share an edge are never checked against each other here
+(every feature of one shares a vertex with the other); the solver keeps them
+apart by refusing a step that turns their hinge through ±180°
+(:class:`foldcore.sheet.SheetSolver`).
 
 Units: the sheet's normalised frame (its bounding radius is 1); the report
 gives gaps in mm.

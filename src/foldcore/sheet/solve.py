@@ -13,7 +13,9 @@ steps succeed, so the last steps are Newton's, quadratically convergent.
 
 With ``contact`` the sheet's triangles never pass through each other: IPC's
 barrier joins the energy and every step is shortened to the share of it that
-no two triangles cross on (:mod:`foldcore.contact.sheet`).
+no two triangles cross on (:mod:`foldcore.contact.sheet`); two triangles that
+share an edge, which the barrier leaves out, by a trial refused where it turns
+their hinge through ±180°.
 """
 from __future__ import annotations
 
@@ -213,8 +215,21 @@ class SheetSolver:
             self.value += self.touch.energy
             self.gradient = self.gradient + self.contact.gradient(self.touch, self.x)
 
+    def _through_flat(self, trial: np.ndarray) -> bool:
+        """Whether a hinge turns through ±180° from x to the trial: its two facets,
+        which contact never checks against each other, would pass through each
+        other."""
+        e = self.energy
+        nodes = self.sheet.nodes[e.is_hinge]
+        out = np.empty(len(nodes))
+        fold_angles(trial, nodes, e.reference[e.is_hinge], out)
+        return bool(np.any(np.abs(out) >= np.pi))
+
     def _trial_energy(self, trial: np.ndarray) -> float:
-        """The energy at a trial point (with its contacts)."""
+        """The energy at a trial point (with its contacts); inf where a hinge turns
+        through flat with contact on."""
+        if self.contact is not None and self._through_flat(trial):
+            return np.inf
         value = self.energy(trial)
         if self.contact is not None:
             self._trial_touch = self.contact.touch(trial)
