@@ -149,13 +149,16 @@ class Energy:
                  self.energies, self.gradients, self.hessians, want_hessian)
         return float(self.energies.sum())
 
-    def settle_references(self, x: np.ndarray) -> None:
-        """Unwrap every hinge's angle from here on near its angle at x."""
-        s = self.sheet
-        hinge_nodes = s.nodes[self.is_hinge]
+    def hinge_angles(self, x: np.ndarray) -> np.ndarray:
+        """(H,) every hinge's angle at x, radians, unwrapped near its reference."""
+        hinge_nodes = self.sheet.nodes[self.is_hinge]
         out = np.empty(len(hinge_nodes))
         fold_angles(x, hinge_nodes, self.reference[self.is_hinge], out)
-        self.reference[self.is_hinge] = out
+        return out
+
+    def settle_references(self, x: np.ndarray) -> None:
+        """Unwrap every hinge's angle from here on near its angle at x."""
+        self.reference[self.is_hinge] = self.hinge_angles(x)
 
 
 def fold_sheet(sheet: Sheet, fold_percent: float = 100.0, start: np.ndarray | None = None,
@@ -219,11 +222,7 @@ class SheetSolver:
         """Whether a hinge turns through ±180° from x to the trial: its two facets,
         which contact never checks against each other, would pass through each
         other."""
-        e = self.energy
-        nodes = self.sheet.nodes[e.is_hinge]
-        out = np.empty(len(nodes))
-        fold_angles(trial, nodes, e.reference[e.is_hinge], out)
-        return bool(np.any(np.abs(out) >= np.pi))
+        return bool(np.any(np.abs(self.energy.hinge_angles(trial)) >= np.pi))
 
     def _trial_energy(self, trial: np.ndarray) -> float:
         """The energy at a trial point (with its contacts); inf where a hinge turns
