@@ -51,6 +51,14 @@ def load_ipctk():
     return ipctk
 
 
+def needs_stiffening(gap: float, last: float, dhat: float, kappa: float,
+                     start: float) -> bool:
+    """IPC's adaptive stiffness rule: κ doubles where the smallest gap (mm) is below
+    ``TIGHT_GAP`` × d̂ and smaller than ``last`` (the previous check's), while κ is
+    below ``MAX_STIFFENING`` × its ``start``."""
+    return gap < TIGHT_GAP * dhat and gap < last and kappa < MAX_STIFFENING * start
+
+
 @dataclass(frozen=True)
 class ContactSettings:
     """How panels touch.
@@ -184,8 +192,7 @@ class ContactModel:
         gaps = np.concatenate([state.gaps[~state.joined], state.obstacle_gaps])
         gap = float(gaps.min()) if len(gaps) else np.inf
         last, self._last_gap = self._last_gap, gap
-        if not (gap < TIGHT_GAP * self.dhat and gap < last) or \
-                self.kappa >= MAX_STIFFENING * self._kappa_start:
+        if not needs_stiffening(gap, last, self.dhat, self.kappa, self._kappa_start):
             return False
         self.kappa *= 2.0
         self._potential = self._potentials()

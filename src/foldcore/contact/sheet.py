@@ -31,7 +31,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ..errors import SimulationError
-from .barrier import MAX_STIFFENING, TIGHT_GAP, load_ipctk
+from .barrier import load_ipctk, needs_stiffening
 
 #: d̂ of a thin sheet, a share of its bounding radius (0.1 %: 0.1 mm on a 10 cm sheet).
 SHEET_ACTIVATION = 1e-3
@@ -181,8 +181,7 @@ class SheetContact:
         ``TIGHT_GAP`` × d̂ and shrinking (up to ``MAX_STIFFENING`` × its start); True
         when it changed (energies taken before are stale)."""
         last, self._last_gap = self._last_gap, touch.gap
-        if not (touch.gap < TIGHT_GAP * self.dhat and touch.gap < last) or \
-                self.kappa >= MAX_STIFFENING * self._kappa_start:
+        if not needs_stiffening(touch.gap, last, self.dhat, self.kappa, self._kappa_start):
             return False
         self.kappa *= 2.0
         self._potential = load_ipctk().BarrierPotential(self.dhat, self.kappa)
