@@ -113,7 +113,7 @@ def overhead(sizes, runs: int, strategy: str = "rigid") -> list:
 
 def flat(sizes, runs: int) -> list:
     from foldcore import patterns
-    from foldcore.contact.solids import PanelSolids
+    from foldcore.contact.solids import PartSolids
     from foldcore.simulation import Simulation
     from foldcore.thickening import thicken
 
@@ -130,7 +130,7 @@ def flat(sizes, runs: int) -> list:
             return _meta.timed(lambda: sim.run(tolerance=1e-8, max_iterations=2_000))
 
         done = _meta.interleaved({c: (lambda c=c: fold(c)) for c in (False, True)}, runs)
-        joined = {tuple(p) for p in PanelSolids(mesh, pattern).joined_pairs.tolist()}
+        joined = {tuple(p) for p in PartSolids(mesh, pattern).joined_pairs.tolist()}
         row = {"n": n, "m": m, "panels": len(pattern.faces)}
         for c in (False, True):
             result = done[c][-1][1]

@@ -1,4 +1,5 @@
-"""Contact: panels that no crease joins never pass through each other, joined panels
+"""Contact: panels that no crease joins never pass through each other, nor hinge
+strips through the parts they meet at no vertex of the pattern, joined panels
 overlap by at most the shrink their contact geometry allows, a contact that never
 engages changes nothing, and every surface says what contact did.
 
@@ -19,7 +20,7 @@ import pytest
 
 pytest.importorskip("ipctk")
 
-from foldcore.contact import ContactSettings, PanelSolids  # noqa: E402
+from foldcore.contact import ContactSettings, PartSolids  # noqa: E402
 from foldcore.contact.barrier import JOINED_SHARE  # noqa: E402
 from foldcore.errors import SimulationError  # noqa: E402
 from foldcore.options import OptionError, Solving  # noqa: E402
@@ -159,7 +160,7 @@ def test_a_thick_miura_driven_flat_stops_where_its_panels_meet_and_says_so():
     assert any("contact stops" in w for w in warnings)
     source = mesh.groups[mesh.panel_group].source
     joined = {tuple(sorted(int(source[p]) for p in pair))
-              for pair in PanelSolids(mesh, pattern).joined_pairs}
+              for pair in PartSolids(mesh, pattern).joined_pairs}
     unjoined = {k: v for k, v in overlap_shares(mesh, held.positions).items() if k not in joined}
     assert not unjoined or max(unjoined.values()) <= OVERLAP_SHARE, unjoined
 
@@ -175,7 +176,7 @@ def test_the_chain_scene_with_contact_keeps_unjoined_panels_apart():
     mesh = run.mesh
     source = mesh.groups[mesh.panel_group].source
     joined = {tuple(sorted(int(source[p]) for p in pair))
-              for pair in PanelSolids(mesh, run.pattern).joined_pairs}
+              for pair in PartSolids(mesh, run.pattern).joined_pairs}
     shares = overlap_shares(mesh, run.result.positions)
     unjoined = {k: v for k, v in shares.items() if k not in joined}
     assert not unjoined or max(unjoined.values()) <= OVERLAP_SHARE, unjoined
@@ -221,6 +222,54 @@ def test_a_step_through_a_panel_far_from_it_at_both_ends_is_cut_short():
     x1 = x0.copy()
     x1[above] -= [0.0, 0.0, 6 * H]
     assert len(contact.overlapping(x0)) == 0 and len(contact.overlapping(x1)) == 0
+    t = contact.free_fraction(x0, x1, joined=False)
+    assert t < 0.5 and len(contact.overlapping(x0 + t * (x1 - x0))) == 0
+
+
+def test_hinge_strips_are_parts_left_to_their_hinges_where_they_meet_a_part():
+    """Every crease's strip is a part; a strip and a panel or strip it meets at a vertex
+    of the pattern are left out (the hinges place them there), every other pair is
+    checked, and none of those is within d̂ in the flat sheet (IPC needs a start
+    without contact)."""
+    from foldcore.contact import ContactModel
+
+    pattern = patterns.miura_one_crease(3, 3, tilt=45.0)
+    mesh = thicken(pattern, H)
+    contact = ContactModel(mesh, pattern, 1.0)
+    s = contact.solids
+    assert s.n_parts == s.n_panels + len(mesh.strips_of_crease)
+    assert sorted(s.part_crease[s.n_panels:]) == sorted(mesh.strips_of_crease)
+    left_out = set(s.left_out.tolist())
+    ends = [set(pattern.faces[f].tolist()) for f in range(len(pattern.faces))]
+    ends = [ends[int(np.flatnonzero(mesh.panel_of_face == p)[0])] for p in range(s.n_panels)]
+    ends += [set(pattern.edges[e].tolist()) for e in s.part_crease[s.n_panels:]]
+    for a, b in combinations(range(s.n_parts), 2):
+        if b < s.n_panels:
+            continue  # panel pairs: as before (joined ones trimmed, the rest checked)
+        assert (a * s.n_parts + b in left_out) == bool(ends[a] & ends[b]), (a, b)
+    assert not contact.state(mesh.rest_positions).active
+
+
+def test_a_panel_moved_through_a_hinge_strip_it_does_not_meet_is_cut_short():
+    """A panel 3 mm above a crease's strip it meets at no vertex of the pattern, moved
+    6 mm down in one step: the step stops short of the strip (only panels were parts
+    once, and the gripper's spines passed through each other and through the jaws)."""
+    from foldcore.contact import ContactModel
+
+    pattern = patterns.miura_one_crease(3, 3, tilt=45.0)
+    mesh = thicken(pattern, H)
+    contact = ContactModel(mesh, pattern, 1.0)
+    s = contact.solids
+    left_out = set(s.left_out.tolist())
+    strip, panel = next((a, b) for a in range(s.n_panels, s.n_parts) for b in range(s.n_panels)
+                        if b * s.n_parts + a not in left_out)
+    x0 = mesh.rest_positions.copy()
+    under, above = s.part_vertices(strip), s.part_vertices(panel)
+    x0[above] += x0[under].mean(axis=0) - x0[above].mean(axis=0) + [0.0, 0.0, 3 * H]
+    x1 = x0.copy()
+    x1[above] -= [0.0, 0.0, 6 * H]
+    assert len(contact.overlapping(x0)) == 0 and len(contact.overlapping(x1)) == 0
+    assert [panel, strip] in contact.overlapping(0.5 * (x0 + x1)).tolist()
     t = contact.free_fraction(x0, x1, joined=False)
     assert t < 0.5 and len(contact.overlapping(x0 + t * (x1 - x0))) == 0
 
@@ -285,7 +334,7 @@ def test_joined_panels_are_trimmed_of_their_hinge_zone():
 
     pattern = letter_pattern()
     mesh = thicken(pattern, H)
-    solids = PanelSolids(mesh, pattern)
+    solids = PartSolids(mesh, pattern)
     width = mesh.hinge_width[solids.joined_crease]
     zones = JoinedZones(solids, mesh, pattern, HINGE_ZONE * width, JOINED_SHARE)
     assert np.allclose(zones.matrix.sum(axis=1), 1.0)  # convex combinations

@@ -1,18 +1,20 @@
 """Obstacles: fixed meshes the sheet touches but never passes.
 
 Scene: three panels 4 | 12 | 4 mm in a row (10 mm deep), H = 1 mm, both
-creases valleys driven to 180°, on a ground plane 0.05 mm below the sheet,
-with a block 9 × 6 × 3 mm standing 0.05 mm above the middle panel. The outer
+creases valleys driven to 180°, on a pedestal 8 × 8 mm 0.05 mm below the
+middle panel, with a block 9 × 6 × 3 mm standing 0.05 mm above it. The outer
 panels fold up onto the block and must stop on it: folded flat they would
 cut through it (checked without the block: they reach 180° and overlap its
-hull).
+hull). The pedestal stays clear of the hinges: a valley's hinge strip swings
+its outer face below the sheet as it folds, and on a table under the whole
+sheet the strips press on it and lift the sheet against the block, which
+then holds it with 0.1 mm of play: the creases jam short of the block
+(checked too: the table, the block and the strips all pressed).
 Bounds: the stop is symmetric (the scene is mirror-symmetric) to what the
 barrier leaves open: each contact holds somewhere within d̂ = 0.01 H of the
 block, so the two creases within degrees(d̂ / 4 mm) = 0.14°; no panel's convex hull
 overlaps the cube's or the ground's by more than 1e-4 of a panel (the
-acceptance bound of contact, manifold3d's exact boolean); the cube is pressed
-(a force > 0): it holds the outer panels up and the middle one down, so the
-sheet needs the ground only where it would drift onto it.
+acceptance bound of contact, manifold3d's exact boolean).
 """
 from __future__ import annotations
 
@@ -51,8 +53,10 @@ def cube(centre=(10.0, 5.0, 0.5 * H + GAP + 1.5), half=(4.5, 3.0, 1.5)) -> Obsta
     return Obstacle(v, np.array(f), "cube")
 
 
-def ground() -> Obstacle:
-    return Obstacle.plane((10.0, 5.0, -0.5 * H - GAP), (0.0, 0.0, 1.0), size=200.0,
+def ground(size: float = 8.0) -> Obstacle:
+    """A plane 0.05 mm below the sheet, ``size`` mm square about the middle panel's
+    centre: 8, a pedestal clear of the hinges; 200, a table under the whole sheet."""
+    return Obstacle.plane((10.0, 5.0, -0.5 * H - GAP), (0.0, 0.0, 1.0), size=size,
                           name="ground")
 
 
@@ -93,8 +97,22 @@ def test_the_panels_stop_on_the_cube_without_passing_it(grasped):
     assert overlaps(mesh, result.positions, cube()) <= 1e-4
     assert overlaps(mesh, result.positions, ground()) <= 1e-4
     entries = {o["name"]: o for o in result.contact["obstacles"]}
-    assert entries["cube"]["magnitude"] > 0 and {0, 2} <= set(entries["cube"]["touching_faces"])
-    assert entries["ground"]["magnitude"] >= 0.0  # the block alone clamps the sheet
+    assert {0, 2} <= set(entries["cube"]["touching_faces"])
+
+
+def test_on_a_table_the_hinges_press_on_it_and_jam_against_the_block(grasped):
+    """The strips' outer faces swing below the sheet: on a table under the whole sheet
+    they press on it, the block presses the panels back, and the creases stop short
+    of where the pedestal let them reach (without hinge strips among the parts
+    contact keeps apart, they passed through the table)."""
+    mesh, result = fold([cube(), ground(200.0)])
+    a, b = result.fold_angles_deg[:2]
+    assert a < grasped[1].fold_angles_deg[0] - 1.0 and abs(a - b) < np.degrees(0.01 * H / 4.0)
+    entries = {o["name"]: o for o in result.contact["obstacles"]}
+    assert entries["ground"]["touching_creases"] == [0, 1]
+    assert entries["ground"]["magnitude"] > 0 and entries["cube"]["magnitude"] > 0
+    assert overlaps(mesh, result.positions, cube()) <= 1e-4
+    assert result.positions[:, 2].min() > -0.5 * H - GAP  # every vertex above the table
 
 
 def test_an_obstacle_through_the_sheet_at_the_start_is_refused():

@@ -19,38 +19,13 @@ from foldcore.errors import PatternWarning
 from foldcore.io import read_file
 from foldcore.sheet import SheetSolver, build_sheet
 
+from solids import crossings
+
 pytest.importorskip("ipctk")
 
 MIURA = Path(__file__).parent / "data" / "real" / "miura-ori.svg"
 #: From Origami Simulator's ``needsCollisions`` folder: its panels stack at 90 %.
 SOLAR = Path(__file__).parent / "data" / "real" / "byu-solar-driven.svg"
-
-
-def crossings(x: np.ndarray, triangles: np.ndarray) -> int:
-    """Edges of the triangles that pass through a triangle sharing no vertex with them
-    (a touch within 1e-12 of the sheet's size does not count)."""
-    edges = np.unique(np.sort(np.vstack([triangles[:, [0, 1]], triangles[:, [1, 2]],
-                                         triangles[:, [2, 0]]]), axis=1), axis=0)
-    a, b, c = (x[triangles[:, k]] for k in range(3))
-    e1, e2 = b - a, c - a
-    eps = 1e-12 * np.ptp(x, axis=0).max()
-    count = 0
-    for i, j in edges:
-        far = ~np.any(triangles == i, axis=1) & ~np.any(triangles == j, axis=1)
-        d = x[j] - x[i]
-        p = np.cross(d, e2[far])
-        det = np.einsum("ij,ij->i", e1[far], p)
-        ok = np.abs(det) > 1e-300
-        s = x[i] - a[far]
-        u = np.einsum("ij,ij->i", s, p) / np.where(ok, det, 1.0)
-        q = np.cross(s, e1[far])
-        v = (q @ d) / np.where(ok, det, 1.0)
-        t = np.einsum("ij,ij->i", e2[far], q) / np.where(ok, det, 1.0)
-        margin = eps / np.linalg.norm(d)
-        inside = ok & (u > margin) & (v > margin) & (u + v < 1 - margin) & \
-            (t > margin) & (t < 1 - margin)
-        count += int(inside.sum())
-    return count
 
 
 def sheet_of(path):

@@ -171,9 +171,12 @@ def actuation_entries(result, pattern) -> dict:
     driven = np.flatnonzero(np.isfinite(targets))
     miss = wrapped_deg(result.fold_angles_deg[driven] - targets[driven])
     is_missed = np.abs(miss) > MISS_WARNING_DEG
-    touching = set((getattr(result, "contact", None) or {}).get("touching_faces", []))
+    contact = getattr(result, "contact", None) or {}
+    touching = set(contact.get("touching_faces", []))
+    strips = set(contact.get("touching_creases", []))
     by_contact = np.array([bool(touching & set(int(f) for f in pattern.edge_faces[e] if f >= 0))
-                           for e in driven], dtype=bool) & is_missed & bool(result.converged)
+                           or int(e) in strips for e in driven],
+                          dtype=bool) & is_missed & bool(result.converged)
     stopped = np.where(by_contact, "contact",
                        np.where(is_missed & bool(result.converged), "binding", None))
     creases = [{"edge": int(e), "target_deg": float(t), "achieved_deg": float(a),

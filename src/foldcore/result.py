@@ -43,11 +43,14 @@ class Result:
     residual : float, the estimated distance to the equilibrium at the end,
         relative to the pattern size (NaN if never measured in the run)
     contact : dict or None, what contact did at the end (None: contact off):
-        ``active_pairs`` (pattern faces of every pair of panels within the
-        barrier's reach), ``smallest_gap_mm``, ``activation_mm`` (d̂),
-        ``stiffness`` (κ, mm³), ``touching_faces`` and ``panel_forces``
-        (per touching panel its face and the contact force, −∂(κ Σ b)/∂x summed
-        over its vertices, mm⁴)
+        ``active_pairs`` (every pair of parts within the barrier's reach, a panel
+        named by its pattern face, a hinge strip as ``{"crease": e}``),
+        ``blocking_pairs`` (the pairs that cut the last step short),
+        ``smallest_gap_mm``, ``activation_mm`` (d̂), ``stiffness`` (κ, mm³),
+        ``touching_faces`` and ``touching_creases`` (the panels and strips in
+        those pairs or on an obstacle), ``panel_forces`` and ``strip_forces``
+        (per touching part its face or crease and the contact force, −∂(κ Σ b)/∂x
+        summed over its vertices, mm⁴), ``obstacles``
     position_targets : list of dict or None, per position target at the end:
         ``name``, ``vertices`` (count), ``alpha``, ``miss_mm`` and
         ``mean_miss_mm`` (its vertices' largest and mean distance from their

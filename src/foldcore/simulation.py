@@ -538,7 +538,7 @@ def position_target_entries(model, contact: dict | None) -> list | None:
     targets = model.pins.targets
     if not targets:
         return None
-    touching = bool(contact and contact["touching_faces"])
+    touching = bool(contact and (contact["touching_faces"] or contact["touching_creases"]))
     limit = TARGET_MISS * model.length_scale
     out = []
     for name, (worst, mean) in model.pins.misses(model.x).items():
@@ -550,31 +550,44 @@ def position_target_entries(model, contact: dict | None) -> list | None:
 
 
 def contact_summary(model) -> dict | None:
-    """:attr:`Result.contact` at the model's positions (None without contact)."""
+    """:attr:`Result.contact` at the model's positions (None without contact): parts
+    named as the folded solid names them, a panel by its pattern face (an int), a
+    hinge strip as ``{"crease": e}``."""
     contact = model.contact
     if contact is None:
         return None
     state = contact.state(model.x)
+    solids = contact.solids
     face = model.mesh.groups[model.mesh.panel_group].source
+    labels = [int(face[p]) for p in range(solids.n_panels)] + \
+        [{"crease": int(e)} for e in solids.part_crease[solids.n_panels:]]
     forces = contact.forces(state)
     blocking = np.array(contact.blocking, dtype=np.int64).reshape(-1, 2)
     touching = np.unique(np.concatenate([state.pairs.ravel(), state.obstacle_pairs[:, 0],
-                                         blocking.ravel()]))
+                                         blocking.ravel()])).astype(np.int64)
+    panels, strips = touching[touching < solids.n_panels], touching[touching >= solids.n_panels]
     obstacles = [] if contact.obstacles is None else contact.obstacles.obstacles
     pressed = contact.obstacle_forces(state)
-    return {"active_pairs": face[state.pairs].tolist(),
-            "blocking_pairs": face[blocking].tolist(),
-            "obstacles": [{"name": o.name, "touching_faces": sorted(
-                              int(face[p]) for p, k in state.obstacle_pairs if k == i),
+    pairs = lambda found: [[labels[a], labels[b]] for a, b in found]  # noqa: E731
+    return {"active_pairs": pairs(state.pairs),
+            "blocking_pairs": pairs(blocking),
+            "obstacles": [{"name": o.name,
+                           "touching_faces": sorted(int(face[p]) for p, k in state.obstacle_pairs
+                                                    if k == i and p < solids.n_panels),
+                           "touching_creases": sorted(int(solids.part_crease[p])
+                                                      for p, k in state.obstacle_pairs
+                                                      if k == i and p >= solids.n_panels),
                            "force": pressed[i].tolist(),
                            "magnitude": float(np.linalg.norm(pressed[i]))}
                           for i, o in enumerate(obstacles)],
             "smallest_gap_mm": _smallest(np.concatenate([state.gaps, state.obstacle_gaps])),
             "activation_mm": contact.dhat, "stiffness": contact.kappa,
-            "touching_faces": face[touching].tolist(),
+            "touching_faces": face[panels].tolist(),
+            "touching_creases": solids.part_crease[strips].tolist(),
             "panel_forces": [{"face": int(face[p]), "force": forces[p].tolist(),
-                              "magnitude": float(np.linalg.norm(forces[p]))}
-                             for p in touching]}
+                              "magnitude": float(np.linalg.norm(forces[p]))} for p in panels],
+            "strip_forces": [{"crease": int(solids.part_crease[p]), "force": forces[p].tolist(),
+                              "magnitude": float(np.linalg.norm(forces[p]))} for p in strips]}
 
 
 def _smallest(values: np.ndarray) -> float | None:

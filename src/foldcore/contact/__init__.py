@@ -1,16 +1,16 @@
-"""Contact: panels that never pass through each other.
+"""Contact: panels and hinge strips that never pass through each other.
 
-:class:`ContactModel` gives the barrier energy of every pair of rigid panels
-that no crease joins, its gradient and Hessian, and the largest
-collision-free fraction of a step (:mod:`.barrier`); :class:`PanelSolids`
-holds the panels' closed prisms and the broad phase (:mod:`.solids`);
-:class:`Obstacle` a fixed mesh the panels touch but never pass
-(:mod:`.obstacles`).
+:class:`ContactModel` gives the barrier energy of every pair of parts (rigid
+panels, hinge strips) that contact keeps apart, its gradient and Hessian, and
+the largest collision-free fraction of a step (:mod:`.barrier`);
+:class:`PartSolids` holds the panels' closed prisms, the strips' surfaces and
+the broad phase (:mod:`.solids`); :class:`Obstacle` a fixed mesh the parts
+touch but never pass (:mod:`.obstacles`).
 Strategies that take contact read ``model.contact``.
 """
 from .barrier import ContactModel, ContactSettings, ContactState
 from .obstacles import Obstacle, ObstacleError, read_obstacle
-from .solids import PanelSolids
+from .solids import PartSolids
 
 __all__ = ["ContactModel", "ContactSettings", "ContactState", "Obstacle", "ObstacleError",
-           "PanelSolids", "read_obstacle"]
+           "PartSolids", "read_obstacle"]

@@ -1,4 +1,5 @@
-"""Contact between panels: IPC's barrier potential and continuous collision detection.
+"""Contact between parts (panels, hinge strips): IPC's barrier potential and continuous
+collision detection.
 
 Geometry comes from the IPC Toolkit (``ipctk``, Li et al., "Incremental
 Potential Contact", 2020): its point–triangle and edge–edge distances, the
@@ -6,10 +7,10 @@ log barrier b(d) that is zero from the activation distance d̂ on and grows
 without bound as d → 0, its gradient and PSD-projected Hessian, and a
 conservative continuous collision check (additive CCD) that bounds how far a
 straight-line step may go before any two triangles meet. foldcore's own part
-is which pairs to ask it about (:class:`~.solids.PanelSolids`): only pairs of
-panels the broad phase cannot prove apart, each as a two-body collision mesh
-(cached), so a sheet with nothing near costs a box test and a slab test per
-step. Why ipctk and why panel pairs: `docs/architecture.md#contact`.
+is which pairs to ask it about (:class:`~.solids.PartSolids`): only pairs of
+parts (panels, hinge strips) the broad phase cannot prove apart, each as a
+two-body collision mesh (cached), so a sheet with nothing near costs a box test and a slab test per
+step. Why ipctk and why part pairs: `docs/architecture.md#contact`.
 
 Units: positions mm; the contact energy κ Σ b is in the model's energy unit
 (mm⁵, the strips' weighted squared distances), its gradient (the contact
@@ -23,7 +24,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from .obstacles import ObstacleContacts
-from .solids import JoinedZones, PanelSolids
+from .solids import JoinedZones, PartSolids
 
 #: Share of a straight-line step taken up to the first touch (IPC's 0.8–0.9).
 CCD_RESCALING = 0.9
@@ -61,7 +62,7 @@ def needs_stiffening(gap: float, last: float, dhat: float, kappa: float,
 
 @dataclass(frozen=True)
 class ContactSettings:
-    """How panels touch.
+    """How parts touch.
 
     Attributes
     ----------
@@ -89,7 +90,8 @@ class ContactState:
     Attributes
     ----------
     pairs : (K, 2) int
-        Panel pairs with at least one primitive pair within d̂.
+        Part pairs (:class:`~.solids.PartSolids`: panels, then strips) with at
+        least one primitive pair within d̂.
     gaps : (K,) float
         Each pair's smallest distance, mm.
     joined : (K,) bool
@@ -97,7 +99,7 @@ class ContactState:
     energy : float
         κ Σ b over every active primitive pair, mm⁵.
     obstacle_pairs : (L, 2) int
-        (panel, obstacle) pairs within d̂.
+        (part, obstacle) pairs within d̂.
     obstacle_gaps : (L,) float
         Their smallest distances, mm.
     """
@@ -109,11 +111,11 @@ class ContactState:
     joined: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=bool))
     obstacle_pairs: np.ndarray = field(default_factory=lambda: np.zeros((0, 2), np.int64))
     obstacle_gaps: np.ndarray = field(default_factory=lambda: np.zeros(0))
-    _obstacle_of: list = field(default_factory=list)  # obstacle of each term (−1: panels)
+    _obstacle_of: list = field(default_factory=list)  # obstacle of each term (−1: parts)
 
     @property
     def active(self) -> bool:
-        """Whether any barrier term acts (between panels or with an obstacle)."""
+        """Whether any barrier term acts (between parts or with an obstacle)."""
         return bool(self._terms)
 
 
@@ -135,7 +137,7 @@ class ContactModel:
     def __init__(self, mesh, pattern, reference_weight: float,
                  settings: ContactSettings | None = None, obstacles=()):
         self.settings = settings or ContactSettings()
-        self.solids = PanelSolids(mesh, pattern)
+        self.solids = PartSolids(mesh, pattern)
         self.zones = JoinedZones(self.solids, mesh, pattern,
                                  HINGE_ZONE * mesh.hinge_width[self.solids.joined_crease],
                                  JOINED_SHARE)
@@ -152,7 +154,7 @@ class ContactModel:
         self.obstacles = ObstacleContacts(self.solids, obstacles, self._potential[False],
                                           self._ccd) if len(obstacles) else None
         self._kappa_start, self._last_gap = self.kappa, np.inf
-        #: panel pairs that cut the last step checked (:meth:`free_fraction`) short
+        #: part pairs that cut the last step checked (:meth:`free_fraction`) short
         self.blocking: list = []
 
     def _potentials(self) -> dict:
@@ -174,15 +176,16 @@ class ContactModel:
 
     def take_over(self, other: "ContactModel", panels: np.ndarray) -> None:
         """Go on from ``other``'s run (a twin's, :meth:`twin`): its κ and the pairs
-        that cut its last step short, its panel p being this model's panels[p]."""
+        that cut its last step short, its panel p being this model's panels[p] (its
+        strips this model's strips of the same creases)."""
         if other.kappa != self.kappa:
             self.kappa = other.kappa
             self._potential = self._potentials()
             if self.obstacles is not None:
                 self.obstacles.potential = self._potential[False]
         self._last_gap = other._last_gap
-        self.blocking = [tuple(sorted((int(panels[a]), int(panels[b]))))
-                         for a, b in other.blocking]
+        own = self.solids.part_of(other.solids, panels)
+        self.blocking = [tuple(sorted((int(own[a]), int(own[b])))) for a, b in other.blocking]
 
     def stiffen(self, state: "ContactState") -> bool:
         """IPC's adaptive stiffness: doubles κ where the smallest gap of unjoined pairs
@@ -202,7 +205,8 @@ class ContactModel:
 
     # -------------------------------------------------------------- pairs
     def candidates(self, x: np.ndarray, margin: float) -> np.ndarray:
-        """(K, 2) unjoined panel pairs not proved farther apart than ``margin`` mm."""
+        """(K, 2) part pairs, not left out (joined panels, strips that meet at a
+        vertex), not proved farther apart than ``margin`` mm."""
         lo, hi = self.solids.boxes(x)
         pairs = self.solids.pairs_near(lo, hi, margin)
         if len(pairs):
@@ -238,7 +242,7 @@ class ContactModel:
         return out
 
     def _pair_mesh(self, a: int, b: int):
-        """(collision mesh, model vertex ids, None) of panels a and b, cached."""
+        """(collision mesh, model vertex ids, None) of parts a and b, cached."""
         key = (a, b)
         if key not in self._meshes:
             s = self.solids
@@ -305,6 +309,13 @@ class ContactModel:
             state.obstacle_gaps = np.array(gaps, dtype=float)
         return state
 
+    def touching(self, state: ContactState) -> list:
+        """[(key, (n,) model vertex ids)] of every barrier term at ``state``: a pair's two
+        parts (key (a, b)), a part an obstacle presses (key (p,))."""
+        s = self.solids
+        return ([((int(a), int(b)), s.pair_vertices(int(a), int(b))) for a, b in state.pairs]
+                + [((int(p),), s.part_vertices(int(p))) for p, _ in state.obstacle_pairs])
+
     def gradient(self, state: ContactState) -> np.ndarray:
         """(N, 3) ∂(κ Σ b)/∂x at a state's positions, mm⁴."""
         out = np.zeros((self.n_vertices, 3))
@@ -340,7 +351,7 @@ class ContactModel:
 
     # ------------------------------------------------------------- steps
     def free_fraction(self, x0: np.ndarray, x1: np.ndarray, joined: bool = True) -> float:
-        """A share t ∈ [0, 1] of the step x0 → x1 that brings no two panels into
+        """A share t ∈ [0, 1] of the step x0 → x1 that brings no two parts into
         contact; 1 where nothing comes near. x0 must be intersection-free.
 
         Unjoined pairs: the largest t for which the straight-line motion
@@ -355,7 +366,7 @@ class ContactModel:
         whose panels are not exactly rigid: their hinge holds them)."""
         s = self.solids
         self.blocking = []
-        if not s.n_panels:
+        if not s.n_parts:
             return 1.0
         lo0, hi0 = s.boxes(x0)
         lo1, hi1 = s.boxes(x1)
@@ -385,7 +396,7 @@ class ContactModel:
         return fraction
 
     def overlapping(self, x: np.ndarray) -> np.ndarray:
-        """(K, 2) unjoined panel pairs whose surfaces intersect at x (a check, not a
+        """(K, 2) part pairs, not left out, whose surfaces intersect at x (a check, not a
         step's work)."""
         ipctk = load_ipctk()
         found = []
@@ -396,12 +407,12 @@ class ContactModel:
         return np.array(found, dtype=np.int64).reshape(-1, 2)
 
     def obstacles_touching(self, x: np.ndarray) -> list:
-        """[(panel, obstacle)] intersecting or touching at x (empty without obstacles)."""
+        """[(part, obstacle)] intersecting or touching at x (empty without obstacles)."""
         return [] if self.obstacles is None else self.obstacles.touching(x)
 
     def obstacle_forces(self, state: ContactState) -> np.ndarray:
-        """(n_obstacles, 3) force the panels press each obstacle with (Σ of the
-        barrier's gradient on the panels' vertices of its terms), mm⁴."""
+        """(n_obstacles, 3) force the parts press each obstacle with (Σ of the
+        barrier's gradient on the parts' vertices of its terms), mm⁴."""
         n = 0 if self.obstacles is None else len(self.obstacles.obstacles)
         out = np.zeros((n, 3))
         for o, (ids, collisions, mesh, local, potential, pull) in zip(state._obstacle_of,
@@ -412,9 +423,20 @@ class ContactModel:
         return out
 
     def forces(self, state: ContactState) -> np.ndarray:
-        """(n_panels, 3) contact force on each panel (−Σ of its vertices' barrier
-        gradients), mm⁴."""
-        gradient = self.gradient(state)
-        s = self.solids
-        return -np.add.reduceat(gradient[s.vertices], s.ptr[:-1]) if s.n_panels \
-            else np.zeros((0, 3))
+        """(n_parts, 3) contact force on each part: −Σ of the barrier's gradient on its
+        vertices, term by term (a vertex a strip shares with its panel counts for
+        the part whose term it is), mm⁴."""
+        out = np.zeros((self.solids.n_parts, 3))
+        pairs, pressed = iter(state.pairs), iter(state.obstacle_pairs)
+        for o, (ids, collisions, mesh, local, potential, pull) in zip(state._obstacle_of,
+                                                                       state._terms):
+            g = potential.gradient(collisions, mesh, local)
+            g = (g if pull is None else pull.T @ g).reshape(-1, 3)
+            if o >= 0:
+                out[next(pressed)[0]] -= g.sum(axis=0)
+                continue
+            a, b = (int(p) for p in next(pairs))
+            n_a = len(self.solids.part_vertices(a))
+            out[a] -= g[:n_a].sum(axis=0)
+            out[b] -= g[n_a:].sum(axis=0)
+        return out

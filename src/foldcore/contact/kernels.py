@@ -1,7 +1,9 @@
-"""numba kernels of the panel broad phase (:class:`~.solids.PanelSolids`).
+"""numba kernels of the parts' broad phase (:class:`~.solids.PartSolids`).
 
-A panel is a run ``vertices[ptr[p]:ptr[p + 1]]`` of model vertex ids, its top
-loop first, the bottom loop after it. Each kernel walks those runs in place:
+A part is a run ``vertices[ptr[p]:ptr[p + 1]]`` of model vertex ids: a panel's
+top loop first, the bottom loop after it; a hinge strip's top vertices, then
+its bottom's (the "normal" its first half gives is then some axis, and any
+axis gives a valid bound). Each kernel walks those runs in place:
 no gathered copies of the positions, no temporaries per pair (the numpy
 version of the separating-axis bound built some twenty arrays per call and
 cost a tenth of a rigid step on a Miura 40 × 40). Units: mm.

@@ -2,12 +2,12 @@
 
 A table the sheet rests on (:meth:`Obstacle.plane`), an object a gripper
 closes on (:func:`read_obstacle`: STL, OBJ, PLY, … through meshio). Each
-obstacle meets each rigid panel as IPC meets two panels (:mod:`.barrier`):
-the same barrier (d̂, κ), the same CCD-bounded steps, on a two-body
-collision mesh of the panel's prism and the obstacle's triangles near it,
-whose vertices do not move (their rows of the barrier's derivatives are
-dropped). Broad phase: the obstacle's triangle boxes (a k-d tree of their
-centres) against each panel's box. Units: mm.
+obstacle meets each part (rigid panel, hinge strip) as IPC meets two parts
+(:mod:`.barrier`): the same barrier (d̂, κ), the same CCD-bounded steps, on a
+two-body collision mesh of the part's surface and the obstacle's triangles
+near it, whose vertices do not move (their rows of the barrier's derivatives
+are dropped). Broad phase: the obstacle's triangle boxes (a k-d tree of their
+centres) against each part's box. Units: mm.
 """
 from __future__ import annotations
 
@@ -134,12 +134,12 @@ def read_obstacle(path, name: str | None = None) -> Obstacle:
 
 
 class ObstacleContacts:
-    """Barrier terms and collision-free step fractions between rigid panels and fixed
+    """Barrier terms and collision-free step fractions between parts and fixed
     obstacles.
 
     Parameters
     ----------
-    solids : PanelSolids
+    solids : PartSolids
     obstacles : sequence of Obstacle
     potential
         ipctk barrier potential (d̂, κ) of unjoined pairs (the contact model resets it
@@ -160,8 +160,8 @@ class ObstacleContacts:
             self._reach.append(float(np.linalg.norm(0.5 * (hi - lo), axis=1).max()))
 
     def near(self, lo: np.ndarray, hi: np.ndarray, margin: float) -> list:
-        """[(panel, obstacle, triangle ids)] whose boxes come within ``margin`` mm,
-        for panel boxes (lo, hi), each (n_panels, 3)."""
+        """[(part, obstacle, triangle ids)] whose boxes come within ``margin`` mm,
+        for part boxes (lo, hi), each (n_parts, 3)."""
         centre, half = 0.5 * (lo + hi), 0.5 * (hi - lo)
         radius = np.linalg.norm(half, axis=1) + margin
         out = []
@@ -178,9 +178,9 @@ class ObstacleContacts:
         return out
 
     def pair_mesh(self, p: int, o: int, tris: np.ndarray):
-        """(collision mesh, panel's model vertex ids, obstacle points, selection): panel
-        p's prism and obstacle o's triangles ``tris``; the selection (3n, 3n_p) maps
-        the panel's dofs into the pair's (the obstacle's do not move)."""
+        """(collision mesh, part's model vertex ids, obstacle points, selection): part
+        p's surface and obstacle o's triangles ``tris``; the selection (3n, 3n_p) maps
+        the part's dofs into the pair's (the obstacle's do not move)."""
         import ipctk
 
         s, obstacle = self.solids, self.obstacles[o]
@@ -196,7 +196,7 @@ class ObstacleContacts:
         return mesh, ids, points, np.eye(3 * n)[:, :3 * n_p]
 
     def terms(self, x: np.ndarray, dhat: float) -> tuple[list, list, list]:
-        """([(obstacle, term)], panel–obstacle pairs, their gaps) at positions x; a term
+        """([(obstacle, term)], part–obstacle pairs, their gaps) at positions x; a term
         is (ids, collisions, mesh, local positions, potential, selection) as
         :class:`~.barrier.ContactModel` keeps them."""
         import ipctk
@@ -216,7 +216,7 @@ class ObstacleContacts:
 
     def free_fraction(self, x0: np.ndarray, x1: np.ndarray) -> float:
         """The largest share t ∈ [0, 1] of the straight-line step x0 → x1 that keeps
-        every panel off every obstacle (additive CCD, rescaled)."""
+        every part off every obstacle (additive CCD, rescaled)."""
         import ipctk
 
         s = self.solids
@@ -232,7 +232,7 @@ class ObstacleContacts:
         return fraction
 
     def touching(self, x: np.ndarray) -> list:
-        """[(panel, obstacle)] whose surfaces intersect or touch at x: a start no
+        """[(part, obstacle)] whose surfaces intersect or touch at x: a start no
         barrier can leave."""
         import ipctk
 

@@ -1,13 +1,19 @@
-"""The solids that touch: every rigid panel's closed prism, which panels are joined,
-and a panel-level broad phase that proves most pairs apart without a narrow phase.
+"""The solids that touch: every rigid panel's closed prism and every crease's hinge
+strip, which of them are joined, and a part-level broad phase that proves most
+pairs apart without a narrow phase.
 
 A panel is a prism: its top loop, the same loop H lower, and side quads, all
-vertices its own (the rigid-body layout checks that panels share none). Two
-panels are *joined* when a crease's hinge strip connects them: near their
-crease the hinge model decides how they meet, and at a flat fold they touch
-face to face by design, so contact sees them trimmed of a hinge zone and a
-hair thinner (:class:`JoinedZones`). Every other pair is a contact candidate
-as it is.
+vertices its own (the rigid-body layout checks that panels share none). A
+crease's hinge strip is the outer surface of its sub-strips' prisms (top,
+bottom and the ends; not the faces it shares with its panels or between its
+sub-strips). Two panels are *joined* when a crease's hinge strip connects
+them: near their crease the hinge model decides how they meet, and at a flat
+fold they touch face to face by design, so contact sees them trimmed of a
+hinge zone and a hair thinner (:class:`JoinedZones`). A strip and a part
+that meet at a vertex of the pattern (its crease's panels, the panels and
+strips around its end points) are left to the hinges: there the thickened
+sheet's strips and panel corners overlap by construction, as the hinge model
+places them. Every other pair is a contact candidate as it is.
 
 The broad phase has two stages, both in numba (:mod:`.kernels`): axis-aligned
 boxes (within a margin, sweep and prune), then a separating-axis bound: the gap
@@ -25,8 +31,9 @@ from ..triangulation import triangulate_polygons
 from . import kernels
 
 
-class PanelSolids:
-    """Every rigid panel of a thick mesh as a closed triangulated prism.
+class PartSolids:
+    """Every rigid panel of a thick mesh as a closed triangulated prism, then every
+    crease's hinge strip as its outer surface: the parts contact keeps apart.
 
     Parameters
     ----------
@@ -36,29 +43,57 @@ class PanelSolids:
     Attributes
     ----------
     n_panels : int
+        Parts 0 … n_panels − 1 are the panels (panel element p is part p).
+    n_parts : int
+        Panels, then strips.
+    part_crease : (n_parts,) int64
+        The crease of each strip part (−1 for a panel).
     vertices : (n,) int64
-        Model vertex ids of every panel's corners (top loop, then bottom), panel
-        by panel.
-    ptr : (n_panels + 1,) int64
-        Panel p's vertices are ``vertices[ptr[p]:ptr[p + 1]]``.
+        Model vertex ids of every part: a panel's corners (top loop, then
+        bottom), a strip's surface vertices (top, then bottom), part by part.
+    ptr : (n_parts + 1,) int64
+        Part p's vertices are ``vertices[ptr[p]:ptr[p + 1]]``.
     triangles : list of (T_p, 3) int32
-        Each panel's outward surface triangles, indices local to its vertices.
+        Each part's outward surface triangles, indices local to its vertices.
     joined : (J,) int64
-        Sorted codes a · n_panels + b (a < b) of the panel pairs a crease joins.
+        Sorted codes a · n_parts + b (a < b) of the panel pairs a crease joins.
     joined_pairs : (J, 2) int64
         The joined pairs themselves (a < b).
+    left_out : (L,) int64
+        Sorted codes of the joined pairs and of the strip pairs that meet at a
+        vertex of the pattern: the pairs the broad phase never returns.
     """
 
     def __init__(self, mesh, pattern):
         group = mesh.groups.get(mesh.panel_group)
         self.n_panels = len(group) if group is not None else 0
-        ids = [_corners(group.indices[group.slots(p)], mesh.rest_positions)
-               for p in range(self.n_panels)]
+        rest = mesh.rest_positions  # a property that builds the array anew
+        ids = [_corners(group.indices[group.slots(p)], rest) for p in range(self.n_panels)]
+        triangles = self._triangles(mesh, ids)
+        creases, strip_ids, strip_triangles = _strips(mesh)
+        self.n_parts = self.n_panels + len(creases)
+        self.part_crease = np.concatenate([np.full(self.n_panels, -1), creases]).astype(np.int64)
+        ids += strip_ids
         sizes = np.array([len(i) for i in ids], dtype=np.int64)
         self.vertices = np.concatenate(ids).astype(np.int64) if ids else np.zeros(0, np.int64)
         self.ptr = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
-        self.triangles = self._triangles(mesh, ids)
+        self.triangles = triangles + strip_triangles
         self.joined = self._joined(mesh, pattern)
+        self.left_out = np.union1d(self.joined, self._meeting(mesh, pattern))
+
+    def _meeting(self, mesh, pattern) -> np.ndarray:
+        """Sorted codes of the pairs of a strip and another part that meet at a vertex
+        of the pattern or share a model vertex."""
+        faces = pattern.faces
+        sizes = np.array([len(f) for f in faces], dtype=np.int64)
+        strips = np.arange(self.n_panels, self.n_parts)
+        part = np.concatenate([np.repeat(mesh.panel_of_face[:len(faces)], sizes),
+                               np.repeat(strips, 2),
+                               np.repeat(np.arange(self.n_parts), np.diff(self.ptr))])
+        key = np.concatenate([np.concatenate(faces).astype(np.int64) if len(faces) else [],
+                              pattern.edges[self.part_crease[strips]].ravel(),
+                              len(pattern.vertices) + self.vertices]).astype(np.int64)
+        return _pairs_sharing(key, part.astype(np.int64), self.n_panels, self.n_parts)
 
     def _triangles(self, mesh, ids) -> list:
         """Outward triangles of each prism, local vertex indices."""
@@ -85,31 +120,31 @@ class PanelSolids:
             return np.zeros(0, dtype=np.int64)
         left, right = mesh.measuring_panels(pattern, creases)
         a, b = np.minimum(left, right), np.maximum(left, right)
-        codes, first = np.unique(a * self.n_panels + b, return_index=True)
-        self.joined_pairs = np.column_stack([codes // self.n_panels, codes % self.n_panels])
+        codes, first = np.unique(a * self.n_parts + b, return_index=True)
+        self.joined_pairs = np.column_stack([codes // self.n_parts, codes % self.n_parts])
         self.joined_crease = creases[first]
         return codes
 
     # ---------------------------------------------------------- geometry
     def boxes(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(lo, hi), each (n_panels, 3): every panel's axis-aligned box at positions x."""
-        lo, hi = np.empty((self.n_panels, 3)), np.empty((self.n_panels, 3))
+        """(lo, hi), each (n_parts, 3): every part's axis-aligned box at positions x."""
+        lo, hi = np.empty((self.n_parts, 3)), np.empty((self.n_parts, 3))
         kernels.boxes(_positions(x), self.vertices, self.ptr, lo, hi)
         return lo, hi
 
     def pairs_near(self, lo, hi, margin: float) -> np.ndarray:
-        """(K, 2) panel pairs (a < b, sorted), not joined, whose boxes (lo, hi), each
-        (n_panels, 3), come within ``margin`` mm of each other.
+        """(K, 2) part pairs (a < b, sorted), not left out (:attr:`left_out`), whose
+        boxes (lo, hi), each (n_parts, 3), come within ``margin`` mm of each other.
 
         Sweep and prune in numba (:func:`.kernels.boxes_near`), anew per call: on a
         Miura 40 × 40 it costs about what the exact box test alone cost on a
         Verlet list kept between calls, whose rebuilds (most steps of a fold move
         the panels by more than its skin) cost ten times as much."""
-        if self.n_panels < 2:
+        if self.n_parts < 2:
             return np.zeros((0, 2), dtype=np.int64)
         return kernels.boxes_near(np.ascontiguousarray(lo, np.float64),
                                   np.ascontiguousarray(hi, np.float64), float(margin),
-                                  self.joined)
+                                  self.left_out)
 
     def gap_bounds(self, x: np.ndarray, pairs: np.ndarray, edges=None,
                    later: np.ndarray | None = None) -> np.ndarray:
@@ -138,8 +173,21 @@ class PanelSolids:
                                np.ascontiguousarray(edges, np.int64), out)
         return out
 
+    def part_of(self, other: "PartSolids", panels: np.ndarray) -> np.ndarray:
+        """(other.n_parts,) this thickening's part of each of ``other``'s (another
+        thickening of the same pattern): its panel p is ``panels[p]``, its strips
+        this one's strips of the same creases."""
+        strip = {int(e): p for p, e in enumerate(self.part_crease) if e >= 0}
+        return np.concatenate([np.asarray(panels, dtype=np.int64)[:other.n_panels],
+                               [strip[int(e)] for e in other.part_crease[other.n_panels:]]]
+                              ).astype(np.int64)
+
+    def part_vertices(self, p: int) -> np.ndarray:
+        """Model vertex ids of part p."""
+        return self.vertices[self.ptr[p]:self.ptr[p + 1]]
+
     def pair_vertices(self, a: int, b: int) -> np.ndarray:
-        """Model vertex ids of panels a then b."""
+        """Model vertex ids of parts a then b."""
         return np.concatenate([self.vertices[self.ptr[a]:self.ptr[a + 1]],
                                self.vertices[self.ptr[b]:self.ptr[b + 1]]])
 
@@ -161,7 +209,7 @@ class JoinedZones:
 
     Parameters
     ----------
-    solids : PanelSolids
+    solids : PartSolids
     mesh : foldcore.mesh.ThickMesh
     pattern : foldcore.pattern.CreasePattern
     depths : (J,) float
@@ -172,7 +220,7 @@ class JoinedZones:
     Attributes
     ----------
     pairs : (J, 2) int64
-        The joined panel pairs (``PanelSolids.joined_pairs``).
+        The joined panel pairs (``PartSolids.joined_pairs``).
     ptr : (2J + 1,) int64
         Rows of y: panel a of pair k is ``ptr[2k]:ptr[2k + 1]``, its b the next run.
     matrix : (ptr[-1], N) scipy.sparse.csr_matrix
@@ -184,7 +232,7 @@ class JoinedZones:
 
     MAX_TRIM = 0.25
 
-    def __init__(self, solids: PanelSolids, mesh, pattern, depths: np.ndarray, share: float):
+    def __init__(self, solids: PartSolids, mesh, pattern, depths: np.ndarray, share: float):
         self.pairs = solids.joined_pairs
         self._solids = solids
         panels = self.pairs.ravel()  # side 2k: panel a of pair k, 2k + 1: its b
@@ -224,14 +272,14 @@ class JoinedZones:
         return np.arange(self.ptr[2 * k], self.ptr[2 * k + 2])
 
     def pair(self, k: int) -> tuple[np.ndarray, np.ndarray]:
-        """(model vertex ids (n,) of pair k's corners (``PanelSolids.pair_vertices``),
+        """(model vertex ids (n,) of pair k's corners (``PartSolids.pair_vertices``),
         (n, n) weights: its trimmed corners are weights @ x[ids])."""
         a, b = (int(p) for p in self.pairs[k])
         ids = self._solids.pair_vertices(a, b)
         return ids, self.matrix[self.rows(k)][:, ids].toarray()
 
     def gap_bounds(self, y: np.ndarray, which: np.ndarray) -> np.ndarray:
-        """(K,) :meth:`PanelSolids.gap_bounds` of the trimmed pairs ``which`` (K,) at
+        """(K,) :meth:`PartSolids.gap_bounds` of the trimmed pairs ``which`` (K,) at
         trimmed positions y."""
         out = np.empty(len(which))
         if len(which):
@@ -315,6 +363,58 @@ def _trim_entries(ids: np.ndarray, i, j, t_i, t_j, share: float):
         vals[:, rows_of_face] = np.concatenate([(1.0 - 0.5 * share) * plane_vals,
                                                 0.5 * share * plane_vals], axis=2)
     return rows, cols, vals
+
+
+def _pairs_sharing(key: np.ndarray, part: np.ndarray, n_panels: int,
+                   n_parts: int) -> np.ndarray:
+    """Sorted codes a · n_parts + b (a < b, one of them a strip: ≥ ``n_panels``) of the
+    parts that share a key (incidences (key, part), each (K,))."""
+    order = np.lexsort((part, key))
+    key, part = key[order], part[order]
+    codes = []
+    for shift in range(1, len(key)):
+        same = key[shift:] == key[:-shift]
+        if not same.any():
+            break
+        a, b = part[:-shift][same], part[shift:][same]
+        a, b = np.minimum(a, b), np.maximum(a, b)
+        keep = (a < b) & (b >= n_panels)
+        codes.append(a[keep] * n_parts + b[keep])
+    return np.unique(np.concatenate(codes)) if codes else np.zeros(0, dtype=np.int64)
+
+
+def _strips(mesh) -> tuple[np.ndarray, list, list]:
+    """((C,) creases with a hinge strip, [(n_c,) model vertex ids: its surface's top
+    vertices, then its bottom's], [(T_c, 3) int32 triangles, local]) of every
+    crease's strip: the faces of its sub-strips' prisms that no other of its
+    sub-strips shares and that do not lie on a panel (all corners one panel's)."""
+    group = mesh.groups.get("bending_hinge")
+    if group is None or not mesh.strips_of_crease:
+        return np.zeros(0, dtype=np.int64), [], []
+    owner = np.full(mesh.n_vertices, -1, dtype=np.int64)
+    panels = mesh.groups.get(mesh.panel_group)
+    if panels is not None:
+        owner[panels.indices] = np.repeat(np.arange(len(panels)), np.diff(panels.indptr))
+    n_top = len(mesh.points)
+    creases, ids, triangles = [], [], []
+    for e in sorted(mesh.strips_of_crease):
+        loops = [loop for s in mesh.strips_of_crease[e]
+                 for loop, _ in prism_face_loops(group.indices[group.slots(int(s))])]
+        keys = [tuple(sorted(loop.tolist())) for loop in loops]
+        kept = [loop for loop, key in zip(loops, keys)
+                if keys.count(key) == 1 and not (owner[loop[0]] >= 0 and
+                                                 (owner[loop] == owner[loop[0]]).all())]
+        if not kept:
+            continue
+        used = np.unique(np.concatenate(kept))
+        used = np.concatenate([used[used < n_top], used[used >= n_top]])
+        local = {int(v): i for i, v in enumerate(used)}
+        fans = [[local[int(loop[0])], local[int(loop[i])], local[int(loop[i + 1])]]
+                for loop in kept for i in range(1, len(loop) - 1)]
+        creases.append(e)
+        ids.append(used.astype(np.int64))
+        triangles.append(np.array(fans, dtype=np.int32))
+    return np.array(creases, dtype=np.int64), ids, triangles
 
 
 def _corners(ids: np.ndarray, rest: np.ndarray) -> np.ndarray:

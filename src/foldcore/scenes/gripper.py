@@ -74,7 +74,7 @@ CONTACT = True  # the scene's default: its point is where the jaws stop
 # Pattern faces (patterns.gripper): jaws' halves, covers.
 UPPER_JAW, LOWER_JAW = (0, 4), (1, 5)
 RIGHT_COVER, LEFT_COVER = 2, 3
-TOP_SPINE, BACK, LEG = 0, 2, 3  # crease ids (legs 3..6 fold alike)
+TOP_SPINE, BOTTOM_SPINE, BACK, LEG = 0, 1, 2, 3  # crease ids (legs 3..6 fold alike)
 
 
 def run(quick: bool = False, solver: str | None = None,
@@ -184,15 +184,22 @@ def _row(turn, result, parts, starts, targets, done) -> dict:
 
 
 def _contact(report: dict) -> dict:
-    """What contact did at a step: smallest gap, force magnitude per jaw and on obstacles."""
-    forces = {f["face"]: f["magnitude"] for f in report.get("panel_forces", [])}
+    """What contact did at a step: smallest gap, force magnitude per jaw (its two
+    panels and its spine's hinge strip) and on obstacles, the touching panels and
+    strips."""
+    panels = {f["face"]: f["magnitude"] for f in report.get("panel_forces", [])}
+    strips = {f["crease"]: f["magnitude"] for f in report.get("strip_forces", [])}
+    jaw = lambda faces, spine: round(sum(panels.get(f, 0.0) for f in faces)  # noqa: E731
+                                     + strips.get(spine, 0.0), 6)
     return {"smallest_gap_mm": report.get("smallest_gap_mm"),
-            "upper_jaw_force": round(sum(forces.get(f, 0.0) for f in UPPER_JAW), 6),
-            "lower_jaw_force": round(sum(forces.get(f, 0.0) for f in LOWER_JAW), 6),
+            "upper_jaw_force": jaw(UPPER_JAW, TOP_SPINE),
+            "lower_jaw_force": jaw(LOWER_JAW, BOTTOM_SPINE),
             "obstacles": [{"name": o["name"], "touching_faces": o["touching_faces"],
+                           "touching_creases": o.get("touching_creases", []),
                            "force": round(float(np.linalg.norm(o["force"])), 6)}
                           for o in report.get("obstacles", [])],
-            "touching_faces": report.get("touching_faces", [])}
+            "touching_faces": report.get("touching_faces", []),
+            "touching_creases": report.get("touching_creases", [])}
 
 
 def _deployed(result, pattern, parts) -> dict:

@@ -67,7 +67,8 @@ class UnknownLayout:
         self.pinned = False
         self.ready = False  # the column blocks exist (build_columns)
         self.version = 0  # patterns of the normal matrix built so far (a factor's key)
-        self.contact_pairs = np.zeros((0, 2), dtype=np.int64)  # panel pairs in the pattern
+        #: {pair key: model vertex ids its barrier moves} of the contacts in the pattern
+        self.contacts: dict = {}
 
     # ----------------------------------------------------------- structure
     def _init_panels(self, panels, mesh) -> None:
@@ -275,44 +276,72 @@ class UnknownLayout:
         cols[rows[on], self.off_phi[on]] = self.phi_col + fold_of[on]
         self.loc_cols, self.loc_kind = cols, kind
 
-    def add_contact_pairs(self, pairs: np.ndarray) -> bool:
-        """Make room in the normal matrix for panel pairs (K, 2) that touch; True
-        when the pattern grew (a new symbolic analysis follows). Pairs stay once
-        added: a contact that opens and closes again costs one analysis."""
-        code = lambda p: p[:, 0] * self.n_panels + p[:, 1]  # noqa: E731
-        new = pairs[~np.isin(code(pairs), code(self.contact_pairs))]
-        if not len(new):
+    def add_contacts(self, touching) -> bool:
+        """Make room in the normal matrix for contacts that act: ``touching``, [(key,
+        (n,) model vertex ids its barrier moves)] (``ContactModel.touching``); True
+        when the pattern grew (a new symbolic analysis follows). Contacts stay once
+        added: one that opens and closes again costs one analysis."""
+        new = {key: ids for key, ids in touching if key not in self.contacts}
+        if not new:
             return False
-        self.contact_pairs = np.vstack([self.contact_pairs, new])
+        self.contacts.update(new)
         if self.ready:
             self._normal_pattern()
         return True
+
+    def columns_of(self, ids: np.ndarray) -> np.ndarray:
+        """Sorted columns of the unknowns that move the vertices ``ids`` (P's nonzero
+        columns in their rows): the moving panels they ride on or that carry them,
+        6 each, and a hinge-interior vertex's own 3."""
+        ids = np.asarray(ids, dtype=np.int64)
+        owner = self.owner[ids]
+        free = ids[owner < 0]
+        panels = np.union1d(owner[owner >= 0], self.carry_panel[np.isin(self.carry_vert, free)])
+        panel_cols = self.panel_col[panels.astype(np.int64)]
+        panel_cols = panel_cols[panel_cols >= 0]
+        own = self.free_col[np.searchsorted(self.free, free)]
+        return np.sort(np.concatenate([(panel_cols[:, None] + np.arange(6)).ravel(),
+                                       (own[:, None] + np.arange(3)).ravel()]))
+
+    def _contact_blocks(self) -> list:
+        """Blocks (≤ ``normal.MAX_LOCAL`` columns each, increasing) that hold every
+        pair of the columns each contact moves: those columns in runs of at most
+        half that width, and a block per two runs (a panel pair's 12 columns are
+        one block)."""
+        half = normal.MAX_LOCAL // 2
+        out = []
+        for ids in self.contacts.values():
+            cols = self.columns_of(ids)
+            runs = [cols[i:i + half] for i in range(0, len(cols), half)]
+            out += [np.concatenate([runs[i], runs[j]]) if i != j else runs[i]
+                    for i in range(len(runs)) for j in range(i, len(runs))]
+        return out
 
     def _normal_pattern(self) -> None:
         """Fixed CSC pattern of JᵀJ (:mod:`.normal`'s docstring): indptr, indices and
         the slot of each diagonal entry. Blocks beside the strips': each moving
         panel's 6 × 6 block (position targets), each M/V crease's two panel
-        rotations, each touching panel pair's two panels (contact); every
+        rotations, the columns of each contact (:meth:`_contact_blocks`); every
         column's diagonal comes first in its column."""
         n = self.n_unknowns
         width = normal.MAX_LOCAL
         panel = self.panel_col[self.panel_col >= 0]
         left, right = self.panel_col[self.mv_left], self.panel_col[self.mv_right]
         both = (left >= 0) & (right >= 0)
-        first, second = self.panel_col[self.contact_pairs].T
-        both_move = (first >= 0) & (second >= 0)
-        blocks = [(panel[:, None] + np.arange(6), 6),
-                  (np.column_stack([left[both, None] + np.arange(3),
-                                    right[both, None] + np.arange(3)]), 6),
-                  (np.sort(np.column_stack([first[both_move, None] + np.arange(6),
-                                            second[both_move, None] + np.arange(6)]),
-                           axis=1), 12)]
+        contacts = self._contact_blocks()
+        blocks = [panel[:, None] + np.arange(6),
+                  np.column_stack([left[both, None] + np.arange(3),
+                                   right[both, None] + np.arange(3)]),
+                  np.full((len(contacts), width), -1, dtype=np.int64)]
+        for row, block in zip(blocks[2], contacts):
+            row[:len(block)] = block
         cols, n_loc, kind = [self.loc_cols], [self.n_loc], [self.loc_kind]
-        for block, size in blocks:
+        for block, size in zip(blocks, [np.full(len(blocks[0]), 6), np.full(len(blocks[1]), 6),
+                                        np.array([len(c) for c in contacts])]):
             padded = np.full((len(block), width), -1, dtype=np.int64)
-            padded[:, :size] = block
+            padded[:, :block.shape[1]] = block
             cols.append(padded)
-            n_loc.append(np.full(len(block), size, dtype=np.int64))
+            n_loc.append(np.asarray(size, dtype=np.int64))
             kind.append(np.full((len(block), width), -1, dtype=np.int64))
         indptr, indices = normal.pattern_csc(
             np.concatenate(n_loc), np.concatenate(cols), np.concatenate(kind), n)

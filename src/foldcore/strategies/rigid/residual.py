@@ -274,8 +274,7 @@ class ResidualModel:
                             self.angle_columns(state.rot_e), self.extra_rows(state))
         contact = self.contact_state(state.x)
         if contact is not None and contact.active:
-            if len(contact.pairs):
-                lay.add_contact_pairs(contact.pairs)
+            lay.add_contacts(self.model.contact.touching(contact))
             lin.contact_energy = contact.energy
         data = np.zeros(len(lay.csc_indices))
         lin.grad = np.zeros(lay.n_unknowns)
