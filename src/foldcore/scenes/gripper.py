@@ -36,10 +36,13 @@ in steps of ``TURN_STEP`` up to ``TURN_MAX``, each step starting from the
 last — a position actuation the mechanism can follow, which keeps the jaws'
 mirror plane in place (a straight-line push of one handle is not on the
 mechanism's path and left the strategies a slow compromise, 400–20 000
-iterations a step); with contact the jaws stop on each other; (3) *grasp*:
-the same squeeze with a ball of radius ``BALL_RADIUS`` fixed in the mouth,
-``BALL_AT`` of the way from the back to the deployed tips on the mirror plane
-(an :class:`foldcore.contact.Obstacle`): the jaws stop on the ball.
+iterations a step); with contact the jaws stop on each other: the spines'
+hinge strips, which end at the tips, meet first, and pushed on past the
+touch they give (a hinge strip is as soft across as in bending), so the two
+vertices fold apart and the tips open again; (3) *grasp*: the same squeeze
+with a ball of radius ``BALL_RADIUS`` fixed in the mouth, ``BALL_AT`` of the
+way from the back to the deployed tips on the mirror plane (an
+:class:`foldcore.contact.Obstacle`): the jaws stop on the ball.
 Contact is on by default in this scene (``contact=False``: the jaws pass
 through each other, which is what the quantities then say).
 
@@ -51,8 +54,9 @@ distance of a handle vertex from its target) and what stopped them
 the two jaws' mid-surface points at their spine ends), the thin-limit tip
 distance at the achieved leg angle (the formula above), the back, spine and
 leg angles, the smallest contact gap (mm) and the contact force on each jaw
-and on the ball (mm⁴, the barrier's gradient), the creases contact stopped,
-iterations and convergence.
+(its two panels and its spine's strip) and on the ball (mm⁴, the barrier's
+gradient), the touching panels and strips, iterations and convergence. The
+headline adds the closest the jaws came and at which turn.
 """
 from __future__ import annotations
 
@@ -109,9 +113,14 @@ def run(quick: bool = False, solver: str | None = None,
 
 
 def headline(quantities: dict) -> str:
-    """One line for the demo: the jaw tip distance deployed and where the squeezes end."""
+    """One line for the demo: the jaw tip distance deployed, the closest the squeeze
+    brought them (and at which turn) and where the squeezes end."""
+    steps = quantities["squeeze"]["steps"]
+    closest = min(steps, key=lambda s: s["jaw_tip_distance_mm"])
     line = (f"jaw tips {quantities['deployed']['jaw_tip_distance_mm']} → "
-            f"{quantities['squeeze']['steps'][-1]['jaw_tip_distance_mm']} mm")
+            f"{closest['jaw_tip_distance_mm']} mm at {closest['turn_deg']:g}°")
+    if closest is not steps[-1]:
+        line += f", {steps[-1]['jaw_tip_distance_mm']} mm at {steps[-1]['turn_deg']:g}°"
     if "grasp" in quantities:
         line += f", on the ball {quantities['grasp']['steps'][-1]['jaw_tip_distance_mm']} mm"
     return line
