@@ -12,14 +12,15 @@
 * ``overhead_default``: the same Miuras (the three smallest sizes) with the
   library's defaults but contact (``hybrid``, whose rigid phase starts on the
   coarse twin, which contact turns off).
-* ``flat``: a thick Miura n × m with the graded widths that fold it exactly
-  flat (``miura_flat_widths``, arc hinges, H = 0.2 mm, γ = 84°), every
+* ``flat``: a thick Miura n × m with the graded widths meant to fold it
+  exactly flat (``miura_flat_widths``, arc hinges, H = 0.2 mm, γ = 84°), every
   crease driven to ±180° by ``newton`` from the flat sheet: many panels end
   stacked face to face, the case where contact has the most pairs to hold.
   Contact off and on, interleaved, median of RUNS: iterations, seconds, the
   largest miss from flat, the pairs within d̂ at the end, the smallest gap
   and the worst overlap of two panels' hulls, joined (a crease between
-  them) and not.
+  them) and not, and the pairs of parts contact keeps apart (panels, hinge
+  strips) whose surfaces cross (``ContactModel.overlapping``).
 
 Run: ``python bench/contact.py`` (about 4 min; ``--quick``: sizes 6 and 10,
 one run); writes bench/results/contact.json and .png with the machine and its
@@ -113,6 +114,7 @@ def overhead(sizes, runs: int, strategy: str = "rigid") -> list:
 
 def flat(sizes, runs: int) -> list:
     from foldcore import patterns
+    from foldcore.contact import ContactModel
     from foldcore.contact.solids import PartSolids
     from foldcore.simulation import Simulation
     from foldcore.thickening import thicken
@@ -131,6 +133,7 @@ def flat(sizes, runs: int) -> list:
 
         done = _meta.interleaved({c: (lambda c=c: fold(c)) for c in (False, True)}, runs)
         joined = {tuple(p) for p in PartSolids(mesh, pattern).joined_pairs.tolist()}
+        parts = ContactModel(mesh, pattern, 1.0)
         row = {"n": n, "m": m, "panels": len(pattern.faces)}
         for c in (False, True):
             result = done[c][-1][1]
@@ -142,7 +145,8 @@ def flat(sizes, runs: int) -> list:
                                                  - angles[driven]).max()),
                 "active_pairs": len(result.contact["active_pairs"]) if c else None,
                 "smallest_gap_mm": result.contact["smallest_gap_mm"] if c else None,
-                "worst_unjoined_overlap": unjoined, "worst_joined_overlap": joined_worst}
+                "worst_unjoined_overlap": unjoined, "worst_joined_overlap": joined_worst,
+                "crossing_parts": len(parts.overlapping(result.positions))}
         rows.append(row)
         print(rows[-1], flush=True)
     return rows
@@ -183,12 +187,14 @@ def table(data: dict) -> str:
                   f"{r[key]['seconds']:.2f}", _meta.sig(r[key]["largest_miss_deg"], 2),
                   r[key]["active_pairs"] if r[key]["active_pairs"] is not None else "",
                   _meta.sig(r[key]["worst_unjoined_overlap"], 2),
-                  _meta.sig(r[key]["worst_joined_overlap"], 2)]
+                  _meta.sig(r[key]["worst_joined_overlap"], 2),
+                  r[key].get("crossing_parts", "")]
                  for r in data.get("flat", []) for key in ("off", "on")]
     if flat_rows:
         tables.append(_meta.markdown_table(
             ["graded Miura flat", "contact", "steps", "verdict", "s", "miss (°)",
-             "pairs within d̂", "overlap, unjoined", "overlap, joined"], flat_rows))
+             "pairs within d̂", "overlap, unjoined", "overlap, joined",
+             "parts crossing"], flat_rows))
     return "\n\n".join(tables)
 
 
