@@ -136,16 +136,16 @@ def run_summary(result, pattern, source: str, fold_percent: float,
                 "the next step would make two of them cross")
         warns.append(f"{source}: contact stops {len(blocked)} of {driven} driven creases short "
                      f"of their targets (edges {', '.join(map(str, blocked[:10]))}"
-                     + (", …" if len(blocked) > 10 else "") + "): their panels touch "
-                     f"others ({near}); the report's contact section "
-                     "lists the touching panels and their forces")
+                     + (", …" if len(blocked) > 10 else "") + "): their panels or hinge "
+                     f"strips touch others ({near}); the report's contact section "
+                     "lists the touching parts and their forces")
     held = [t for t in (getattr(result, "position_targets", None) or [])
             if t["stopped_by"] == "contact"]
     if held:
         warns.append(f"{source}: contact holds {len(held)} position target"
                      + ("s" if len(held) > 1 else "") + " back ("
                      + ", ".join(f"{t['name']} by {t['miss_mm']:.3g} mm" for t in held[:5])
-                     + (", …" if len(held) > 5 else "") + "): panels touch on the way; "
+                     + (", …" if len(held) > 5 else "") + "): parts touch on the way; "
                      "the report's contact section lists them and their forces")
     if driven and entries["binding"]:
         missed, wrong = entries["missed"] - len(entries["contact_blocked"]), entries["wrong_side"]
