@@ -9,8 +9,8 @@ conservative continuous collision check (additive CCD) that bounds how far a
 straight-line step may go before any two triangles meet. foldcore's own part
 is which pairs to ask it about (:class:`~.solids.PartSolids`): only pairs of
 parts (panels, hinge strips) the broad phase cannot prove apart, each as a
-two-body collision mesh (cached), so a sheet with nothing near costs a box test and a slab test per
-step. Why ipctk and why part pairs: `docs/architecture.md#contact`.
+two-body collision mesh (cached), so a sheet with nothing near costs a box
+test and a slab test per step. Why ipctk and why part pairs: `docs/architecture.md#contact`.
 
 Units: positions mm; the contact energy κ Σ b is in the model's energy unit
 (mm⁵, the strips' weighted squared distances), its gradient (the contact
@@ -121,7 +121,7 @@ class ContactState:
 
 class ContactModel:
     """Barrier energy, its derivatives and collision-free step fractions of a mesh's
-    rigid panels.
+    parts: rigid panels and hinge strips.
 
     Parameters
     ----------
@@ -131,7 +131,7 @@ class ContactModel:
         The model's reference weight (mm³): κ = ``settings.stiffness`` × it.
     settings : ContactSettings
     obstacles : sequence of :class:`~.obstacles.Obstacle`
-        Fixed meshes the panels touch but never pass (:mod:`.obstacles`).
+        Fixed meshes the parts touch but never pass (:mod:`.obstacles`).
     """
 
     def __init__(self, mesh, pattern, reference_weight: float,
