@@ -347,9 +347,8 @@ def miura_fold_angles(n: int, m: int, gamma: float, tilt: float) -> np.ndarray:
 def miura_flat_widths(n: int, m: int, width: float) -> np.ndarray:
     """(E,) hinge widths (mm) with which a thick :func:`miura` ``(n, m)`` folds
     exactly flat with arc hinges (``thicken(..., hinge="arc")``); NaN on the boundary.
-    Its angles reach flat; its strips then pass through panels and strips they
-    meet at no vertex, and with contact the fold stops short of flat
-    (`docs/benchmarks.md#contact`).
+    Its angles reach flat, its strips then cross other parts: with contact the fold
+    stops short (`docs/benchmarks.md#contact`).
 
     Folded flat, a degree-4 vertex stacks its four panels in four layers. The
     crease opposite its odd crease (the one whose M/V differs from the other
