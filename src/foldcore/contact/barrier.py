@@ -316,12 +316,20 @@ class ContactModel:
         return ([((int(a), int(b)), s.pair_vertices(int(a), int(b))) for a, b in state.pairs]
                 + [((int(p),), s.part_vertices(int(p))) for p, _ in state.obstacle_pairs])
 
+    @staticmethod
+    def _term_gradients(state: ContactState):
+        """Per barrier term at ``state``: (its obstacle or −1, model vertex ids (n,),
+        ∂(κ b)/∂x on them (n, 3) mm⁴, pulled back to the model's vertices)."""
+        for o, (ids, collisions, mesh, local, potential, pull) in zip(state._obstacle_of,
+                                                                       state._terms):
+            g = potential.gradient(collisions, mesh, local)
+            yield o, ids, (g if pull is None else pull.T @ g).reshape(-1, 3)
+
     def gradient(self, state: ContactState) -> np.ndarray:
         """(N, 3) ∂(κ Σ b)/∂x at a state's positions, mm⁴."""
         out = np.zeros((self.n_vertices, 3))
-        for ids, collisions, mesh, local, potential, pull in state._terms:
-            g = potential.gradient(collisions, mesh, local)
-            out[ids] += (g if pull is None else pull.T @ g).reshape(-1, 3)
+        for _, ids, g in self._term_gradients(state):
+            out[ids] += g
         return out
 
     def hessian_blocks(self, state: ContactState):
@@ -415,11 +423,9 @@ class ContactModel:
         barrier's gradient on the parts' vertices of its terms), mm⁴."""
         n = 0 if self.obstacles is None else len(self.obstacles.obstacles)
         out = np.zeros((n, 3))
-        for o, (ids, collisions, mesh, local, potential, pull) in zip(state._obstacle_of,
-                                                                       state._terms):
+        for o, _, g in self._term_gradients(state):
             if o >= 0:
-                g = pull.T @ potential.gradient(collisions, mesh, local)
-                out[o] += g.reshape(-1, 3).sum(axis=0)
+                out[o] += g.sum(axis=0)
         return out
 
     def forces(self, state: ContactState) -> np.ndarray:
@@ -428,10 +434,7 @@ class ContactModel:
         the part whose term it is), mm⁴."""
         out = np.zeros((self.solids.n_parts, 3))
         pairs, pressed = iter(state.pairs), iter(state.obstacle_pairs)
-        for o, (ids, collisions, mesh, local, potential, pull) in zip(state._obstacle_of,
-                                                                       state._terms):
-            g = potential.gradient(collisions, mesh, local)
-            g = (g if pull is None else pull.T @ g).reshape(-1, 3)
+        for o, _, g in self._term_gradients(state):
             if o >= 0:
                 out[next(pressed)[0]] -= g.sum(axis=0)
                 continue
